@@ -1,0 +1,426 @@
+//! The BVH reader.
+//!
+//! The hierarchy is small and irregular, so it goes through a token cursor that knows line
+//! numbers; the frame section is large and regular, so it is read row by row straight from the
+//! bytes. Nesting uses an explicit stack (no recursion, so deep files cannot overflow the
+//! stack), and the header's frame count is checked against the bytes that follow before any
+//! frame memory is reserved.
+
+use super::{number::parse_f64, Bvh, BvhError, BvhJoint, Channel};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Most channels a joint may declare. Six covers position + rotation; anything more is a
+/// different format (scale channels, corrupt counts) and is refused rather than guessed at.
+const MAX_CHANNELS_PER_JOINT: usize = 6;
+
+/// Read and parse a BVH file. `-` reads standard input.
+pub fn read_path(path: &Path) -> Result<Bvh, BvhError> {
+    let name = path.display().to_string();
+    let data = if name == "-" {
+        let mut buf = Vec::new();
+        std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut buf)
+            .map_err(|source| BvhError::Io { file: "<stdin>".into(), source })?;
+        return parse_bytes(&buf, "<stdin>");
+    } else {
+        std::fs::read(path).map_err(|source| BvhError::Io { file: name.clone(), source })?
+    };
+    parse_bytes(&data, &name)
+}
+
+/// Parse BVH text. `file` is only used in error messages.
+pub fn parse(text: &str, file: &str) -> Result<Bvh, BvhError> {
+    parse_bytes(text.as_bytes(), file)
+}
+
+/// Parse BVH bytes (UTF-8 or Latin-1 names are both accepted; names are decoded lossily).
+pub fn parse_bytes(data: &[u8], file: &str) -> Result<Bvh, BvhError> {
+    let data = data.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(data);
+    let mut cur = Cursor { data, pos: 0, line: 1, file };
+    let joints = parse_hierarchy(&mut cur)?;
+    let (frames, frame_time) = parse_motion_header(&mut cur, &joints)?;
+    let channels: usize = joints.iter().map(|j| j.channels.len()).sum();
+    let values = parse_frames(&mut cur, &joints, frames, channels)?;
+    Ok(Bvh { joints, frame_time, frames, values })
+}
+
+struct Cursor<'a> {
+    data: &'a [u8],
+    pos: usize,
+    line: usize,
+    file: &'a str,
+}
+
+fn is_space(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\r' | b'\n' | 0x0B | 0x0C)
+}
+
+fn show(tok: &[u8]) -> String {
+    let s = String::from_utf8_lossy(tok);
+    if s.chars().count() > 40 {
+        format!("{}...", s.chars().take(40).collect::<String>())
+    } else {
+        s.into_owned()
+    }
+}
+
+impl<'a> Cursor<'a> {
+    fn err<T>(&self, line: usize, message: impl Into<String>) -> Result<T, BvhError> {
+        Err(BvhError::Syntax { file: self.file.to_string(), line, message: message.into() })
+    }
+
+    /// Skip whitespace and `#` comments; return the next token and its line, or None at EOF.
+    fn next(&mut self) -> Option<(&'a [u8], usize)> {
+        let d = self.data;
+        loop {
+            while self.pos < d.len() && is_space(d[self.pos]) {
+                if d[self.pos] == b'\n' {
+                    self.line += 1;
+                }
+                self.pos += 1;
+            }
+            if self.pos < d.len() && d[self.pos] == b'#' {
+                while self.pos < d.len() && d[self.pos] != b'\n' {
+                    self.pos += 1;
+                }
+                continue;
+            }
+            break;
+        }
+        if self.pos >= d.len() {
+            return None;
+        }
+        let start = self.pos;
+        while self.pos < d.len() && !is_space(d[self.pos]) {
+            self.pos += 1;
+        }
+        Some((&d[start..self.pos], self.line))
+    }
+
+    /// The next token, or an error naming what was expected.
+    fn expect_any(&mut self, what: &str) -> Result<(&'a [u8], usize), BvhError> {
+        match self.next() {
+            Some(t) => Ok(t),
+            None => self.err(self.line, format!("unexpected end of file: expected {what}")),
+        }
+    }
+
+    fn expect(&mut self, word: &str, what: &str) -> Result<usize, BvhError> {
+        let (tok, line) = self.expect_any(what)?;
+        if tok.eq_ignore_ascii_case(word.as_bytes()) {
+            Ok(line)
+        } else {
+            self.err(line, format!("expected {what}, found '{}'", show(tok)))
+        }
+    }
+
+    fn number(&mut self, what: &str) -> Result<f64, BvhError> {
+        let (tok, line) = self.expect_any(what)?;
+        match parse_f64(tok) {
+            Some(v) => Ok(v),
+            None => self.err(line, format!("expected {what} (a finite number), found '{}'", show(tok))),
+        }
+    }
+
+    /// The rest of the current line, trimmed; used for joint names, which may contain spaces.
+    fn rest_of_line(&mut self) -> &'a [u8] {
+        let d = self.data;
+        let start = self.pos;
+        while self.pos < d.len() && d[self.pos] != b'\n' {
+            self.pos += 1;
+        }
+        let mut s = &d[start..self.pos];
+        while let [first, rest @ ..] = s {
+            if is_space(*first) { s = rest } else { break }
+        }
+        while let [rest @ .., last] = s {
+            if is_space(*last) { s = rest } else { break }
+        }
+        s
+    }
+}
+
+/// The hierarchy under construction, with the bookkeeping needed for good error messages.
+struct Hierarchy {
+    joints: Vec<BvhJoint>,
+    /// Line of each joint's ROOT/JOINT keyword.
+    lines: Vec<usize>,
+    has_offset: Vec<bool>,
+    by_name: HashMap<String, usize>,
+    /// Open joints, innermost last.
+    stack: Vec<usize>,
+}
+
+impl Hierarchy {
+    /// After a ROOT/JOINT keyword: read the name and the opening brace.
+    fn open_joint(&mut self, cur: &mut Cursor, parent: Option<usize>, line: usize) -> Result<(), BvhError> {
+        let raw = cur.rest_of_line();
+        // Accept `JOINT name {` on one line.
+        let (raw, brace_inline) = match raw.strip_suffix(b"{") {
+            Some(r) => (r.trim_ascii_end(), true),
+            None => (raw, false),
+        };
+        if raw.is_empty() {
+            return cur.err(line, "expected a joint name after ROOT/JOINT");
+        }
+        let name = String::from_utf8_lossy(raw).into_owned();
+        if let Some(&first) = self.by_name.get(&name) {
+            return cur.err(line, format!("duplicate joint name '{name}' (first defined at line {})", self.lines[first]));
+        }
+        if !brace_inline {
+            cur.expect("{", &format!("'{{' opening joint '{name}'"))?;
+        }
+        self.by_name.insert(name.clone(), self.joints.len());
+        self.lines.push(line);
+        self.has_offset.push(false);
+        self.stack.push(self.joints.len());
+        self.joints.push(BvhJoint { name, parent, offset: [0.0; 3], channels: Vec::new(), end_sites: Vec::new() });
+        Ok(())
+    }
+
+    fn offset(cur: &mut Cursor, what: &str) -> Result<[f64; 3], BvhError> {
+        let mut o = [0.0; 3];
+        for (k, v) in o.iter_mut().enumerate() {
+            *v = cur.number(&format!("{what} {}", ["x", "y", "z"][k]))?;
+        }
+        Ok(o)
+    }
+
+    fn channels(&mut self, cur: &mut Cursor, j: usize, line: usize) -> Result<(), BvhError> {
+        if !self.joints[j].channels.is_empty() {
+            return cur.err(line, format!("second CHANNELS line for joint '{}'", self.joints[j].name));
+        }
+        let (ntok, nline) = cur.expect_any("a channel count")?;
+        let n = match std::str::from_utf8(ntok).ok().and_then(|s| s.parse::<usize>().ok()) {
+            Some(n) if n <= MAX_CHANNELS_PER_JOINT => n,
+            _ => {
+                return cur.err(
+                    nline,
+                    format!("expected a channel count from 0 to {MAX_CHANNELS_PER_JOINT}, found '{}'", show(ntok)),
+                )
+            }
+        };
+        let mut chans = Vec::with_capacity(n);
+        for _ in 0..n {
+            let (ctok, cline) = cur.expect_any("a channel name")?;
+            match std::str::from_utf8(ctok).ok().and_then(Channel::from_name) {
+                Some(c) if !chans.contains(&c) => chans.push(c),
+                Some(c) => {
+                    return cur.err(cline, format!("channel {c} listed twice for joint '{}'", self.joints[j].name))
+                }
+                None => {
+                    return cur.err(
+                        cline,
+                        format!("expected a channel name (Xposition ... Zrotation), found '{}'", show(ctok)),
+                    )
+                }
+            }
+        }
+        self.joints[j].channels = chans;
+        Ok(())
+    }
+}
+
+fn parse_hierarchy(cur: &mut Cursor) -> Result<Vec<BvhJoint>, BvhError> {
+    cur.expect("HIERARCHY", "'HIERARCHY' at the start of the file")?;
+    let (tok, line) = cur.expect_any("'ROOT'")?;
+    if !tok.eq_ignore_ascii_case(b"ROOT") {
+        return cur.err(line, format!("expected 'ROOT', found '{}'", show(tok)));
+    }
+    let mut h = Hierarchy {
+        joints: Vec::new(),
+        lines: Vec::new(),
+        has_offset: Vec::new(),
+        by_name: HashMap::new(),
+        stack: Vec::new(),
+    };
+    h.open_joint(cur, None, line)?;
+    while let Some(&j) = h.stack.last() {
+        let Some((tok, line)) = cur.next() else {
+            return cur.err(
+                cur.line,
+                format!("unexpected end of file: expected '}}' closing joint '{}'", h.joints[j].name),
+            );
+        };
+        if tok.eq_ignore_ascii_case(b"OFFSET") {
+            if h.has_offset[j] {
+                return cur.err(line, format!("second OFFSET for joint '{}'", h.joints[j].name));
+            }
+            h.joints[j].offset = Hierarchy::offset(cur, &format!("OFFSET of joint '{}':", h.joints[j].name))?;
+            h.has_offset[j] = true;
+        } else if tok.eq_ignore_ascii_case(b"CHANNELS") {
+            h.channels(cur, j, line)?;
+        } else if tok.eq_ignore_ascii_case(b"JOINT") {
+            h.open_joint(cur, Some(j), line)?;
+        } else if tok.eq_ignore_ascii_case(b"End") {
+            cur.expect("Site", "'Site' after 'End'")?;
+            cur.expect("{", "'{' opening End Site")?;
+            cur.expect("OFFSET", "OFFSET inside End Site")?;
+            let o = Hierarchy::offset(cur, &format!("End Site OFFSET under joint '{}':", h.joints[j].name))?;
+            cur.expect("}", "'}' closing End Site")?;
+            h.joints[j].end_sites.push(o);
+        } else if tok == b"}" {
+            if !h.has_offset[j] {
+                return cur.err(line, format!("joint '{}' (line {}) has no OFFSET", h.joints[j].name, h.lines[j]));
+            }
+            h.stack.pop();
+        } else if tok.eq_ignore_ascii_case(b"MOTION") {
+            return cur.err(line, format!("'MOTION' before joint '{}' was closed: unbalanced braces", h.joints[j].name));
+        } else {
+            return cur.err(line, format!("expected OFFSET, CHANNELS, JOINT, End Site or '}}', found '{}'", show(tok)));
+        }
+    }
+    Ok(h.joints)
+}
+
+fn parse_motion_header(cur: &mut Cursor, joints: &[BvhJoint]) -> Result<(usize, f64), BvhError> {
+    let Some((tok, line)) = cur.next() else {
+        return cur.err(cur.line, "unexpected end of file: expected 'MOTION' after the hierarchy");
+    };
+    if tok.eq_ignore_ascii_case(b"ROOT") {
+        return cur.err(line, "a second ROOT: files with several hierarchies are not supported");
+    }
+    if tok == b"}" {
+        return cur.err(line, "unbalanced braces: '}' after the root joint was closed");
+    }
+    if !tok.eq_ignore_ascii_case(b"MOTION") {
+        return cur.err(line, format!("expected 'MOTION' after the hierarchy, found '{}'", show(tok)));
+    }
+    let (tok, line) = cur.expect_any("'Frames:'")?;
+    // Accept both `Frames: 10` and `Frames:10`.
+    let count_tok = if tok.eq_ignore_ascii_case(b"Frames:") {
+        cur.expect_any("a frame count after 'Frames:'")?
+    } else if tok.len() > 7 && tok[..7].eq_ignore_ascii_case(b"Frames:") {
+        (&tok[7..], line)
+    } else {
+        return cur.err(line, format!("expected 'Frames:', found '{}'", show(tok)));
+    };
+    let frames = match std::str::from_utf8(count_tok.0).ok().and_then(|s| s.parse::<u64>().ok()) {
+        Some(n) => n,
+        None => {
+            return cur.err(
+                count_tok.1,
+                format!("expected a frame count (a non-negative integer), found '{}'", show(count_tok.0)),
+            )
+        }
+    };
+    let frames_line = count_tok.1;
+    cur.expect("Frame", "'Frame Time:'")?;
+    cur.expect("Time:", "'Frame Time:'")?;
+    let (ttok, tline) = cur.expect_any("a frame time in seconds")?;
+    let frame_time = match parse_f64(ttok) {
+        Some(t) if t > 0.0 => t,
+        _ => return cur.err(tline, format!("expected a positive frame time in seconds, found '{}'", show(ttok))),
+    };
+    // The frame rows start on the next line.
+    let rest = cur.rest_of_line();
+    if !rest.is_empty() {
+        return cur.err(tline, format!("unexpected '{}' after the frame time", show(rest)));
+    }
+    // Refuse headers that promise more values than the remaining bytes can hold (each value
+    // needs at least one character and one separator), before allocating anything for them.
+    let channels: u64 = joints.iter().map(|j| j.channels.len() as u64).sum();
+    let remaining = (cur.data.len() - cur.pos) as u64;
+    let needed = frames.checked_mul(channels).and_then(|v| v.checked_mul(2));
+    match needed {
+        Some(n) if n <= remaining + 1 || channels == 0 => {}
+        _ => {
+            return cur.err(
+                frames_line,
+                format!(
+                    "Frames: {frames} with {channels} channels needs at least {} bytes of frame data, but only {remaining} follow",
+                    needed.map_or("more than 2^64".to_string(), |n| n.to_string())
+                ),
+            )
+        }
+    }
+    if channels == 0 && frames > 1_000_000_000 {
+        return cur.err(frames_line, format!("absurd frame count {frames} for a skeleton without channels"));
+    }
+    Ok((frames as usize, frame_time))
+}
+
+fn parse_frames(cur: &mut Cursor, joints: &[BvhJoint], frames: usize, channels: usize) -> Result<Vec<f64>, BvhError> {
+    let d = cur.data;
+    // Move to the start of the next line (rest_of_line stopped at the newline).
+    if cur.pos < d.len() {
+        cur.pos += 1;
+        cur.line += 1;
+    }
+    if channels == 0 {
+        return Ok(Vec::new());
+    }
+    let mut values = Vec::with_capacity(frames * channels);
+    let mut row = 0;
+    let mut pos = cur.pos;
+    let mut line = cur.line;
+    while pos < d.len() {
+        let end = d[pos..].iter().position(|&b| b == b'\n').map_or(d.len(), |k| pos + k);
+        let text = &d[pos..end];
+        let mut count = 0usize;
+        let mut i = 0;
+        while i < text.len() {
+            while i < text.len() && is_space(text[i]) {
+                i += 1;
+            }
+            if i == text.len() {
+                break;
+            }
+            let start = i;
+            while i < text.len() && !is_space(text[i]) {
+                i += 1;
+            }
+            if row == frames {
+                return cur.err(line, format!("more frame rows than 'Frames: {frames}' announced"));
+            }
+            if count == channels {
+                return cur.err(line, format!("frame {} has more than the {channels} values the hierarchy declares", row + 1));
+            }
+            match parse_f64(&text[start..i]) {
+                Some(v) => values.push(v),
+                None => {
+                    let (joint, chan) = channel_at(joints, count);
+                    return cur.err(
+                        line,
+                        format!(
+                            "frame {}: expected a finite number for {chan} of joint '{joint}' (value {} of {channels}), found '{}'",
+                            row + 1,
+                            count + 1,
+                            show(&text[start..i])
+                        ),
+                    );
+                }
+            }
+            count += 1;
+        }
+        if count != 0 {
+            if count != channels {
+                return cur.err(
+                    line,
+                    format!("frame {} has {count} values, expected {channels} (one per channel)", row + 1),
+                );
+            }
+            row += 1;
+        }
+        pos = end + 1;
+        line += 1;
+    }
+    if row != frames {
+        return cur.err(
+            line.saturating_sub(1).max(1),
+            format!("file ends after {row} frame rows, but 'Frames: {frames}' announced {frames}"),
+        );
+    }
+    Ok(values)
+}
+
+/// Which joint and channel the `k`-th value of a frame row belongs to (for error messages).
+fn channel_at(joints: &[BvhJoint], mut k: usize) -> (&str, String) {
+    for j in joints {
+        if k < j.channels.len() {
+            return (&j.name, j.channels[k].to_string());
+        }
+        k -= j.channels.len();
+    }
+    ("?", "?".into())
+}
