@@ -1,1 +1,12 @@
+//! menagerie: animate any skeleton from the command line.
+//!
+//! The library behind the binaries in `bins/`: data types at the bottom (`bvh`, `skeleton`,
+//! `motion`), then documents and I/O (`document`, `io`), then tools (`synth`, `cli`).
+
 pub mod bvh;
+pub mod cli;
+pub mod document;
+pub mod io;
+pub mod motion;
+pub mod skeleton;
+pub mod synth;

@@ -1,0 +1,79 @@
+//! What every binary shares: the common options, the error-to-exit-code mapping, and the
+//! clap commands of all tools (so man pages and completions are generated from the very
+//! definitions that parse the arguments).
+//!
+//! Exit codes: 0 ok; 1 a valid but negative answer; 2 usage, I/O or data error. Errors print
+//! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
+
+pub mod skel_info;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Options every tool accepts (flattened into each tool's arguments).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct CommonOpts {
+    /// Write output here instead of stdout ('-' = stdout). Files are written atomically.
+    #[arg(short = 'o', long, value_name = "PATH", global = true)]
+    pub output: Option<PathBuf>,
+    /// Seed for everything random; the same seed and input give byte-identical output.
+    #[arg(long, value_name = "N", default_value_t = 0, global = true)]
+    pub seed: u64,
+    /// Print nothing on stderr but errors.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+    /// Print more about what is happening on stderr.
+    #[arg(short, long, global = true, conflicts_with = "quiet")]
+    pub verbose: bool,
+    /// Worker threads (default: all cores). Output never depends on this.
+    #[arg(long, value_name = "N", global = true)]
+    pub threads: Option<usize>,
+}
+
+impl CommonOpts {
+    /// Apply `--threads` to rayon's global pool (once per process).
+    pub fn init_threads(&self) {
+        if let Some(n) = self.threads {
+            let _ = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global();
+        }
+    }
+}
+
+/// An error that should exit with a specific code (1 = negative answer, 2 = failure).
+#[derive(Debug)]
+pub struct Exit(pub u8);
+
+impl std::fmt::Display for Exit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "exit {}", self.0)
+    }
+}
+impl std::error::Error for Exit {}
+
+/// Run a tool's body and turn its result into an exit code, printing errors as one line.
+pub fn finish(tool: &str, result: anyhow::Result<()>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if is_broken_pipe(&e) {
+                return ExitCode::SUCCESS;
+            }
+            if let Some(Exit(code)) = e.downcast_ref::<Exit>() {
+                return ExitCode::from(*code);
+            }
+            let msg = format!("{e:#}").replace('\n', " ");
+            eprintln!("{tool}: {msg}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe))
+}
+
+/// Every tool's clap command, for man pages, completions and help tests.
+pub fn all_commands() -> Vec<clap::Command> {
+    use clap::CommandFactory;
+    vec![skel_info::Args::command()]
+}

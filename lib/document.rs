@@ -1,0 +1,198 @@
+//! The skeleton document: the JSON that `skel-info` prints and every skeleton-aware tool reads.
+//!
+//! It carries everything a tool needs without the original BVH: the hierarchy (names,
+//! parents, offsets, channel layout, End Sites, frame time: enough to write a BVH back), the
+//! readable names and roles, AnyTop's topology descriptors and rest-pose measurements. The
+//! schema is `docs/skeleton.schema.json`; bump `FORMAT_VERSION` on any incompatible change.
+//! Later versions add optional fields (feature statistics, the rest-pose feature row);
+//! readers ignore fields they do not know.
+
+use crate::bvh::Channel;
+use crate::motion::Motion;
+use crate::skeleton::names::{self, Side};
+use crate::skeleton::roles::{self, FootRule};
+use crate::skeleton::{topology, Joint, Skeleton, Stats};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+pub const FORMAT: &str = "menagerie.skeleton";
+pub const FORMAT_VERSION: u32 = 1;
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SkeletonDocument {
+    pub format: String,
+    pub version: u32,
+    /// Where the skeleton came from (a path, `<stdin>`, or a generator name).
+    pub source: String,
+    pub frame_time: f64,
+    pub joint_count: usize,
+    pub joints: Vec<JointEntry>,
+    pub topology: Topology,
+    pub rest_pose: RestPose,
+    /// Present when the BVH had frames.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionInfo>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct JointEntry {
+    pub name: String,
+    pub normalised: String,
+    pub parent: Option<usize>,
+    pub offset: [f64; 3],
+    pub channels: Vec<String>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub end_sites: Vec<[f64; 3]>,
+    pub side: Side,
+    pub depth: usize,
+    pub end_effector: bool,
+    pub foot: bool,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Topology {
+    pub dmax: usize,
+    /// AnyTop relation types, J x J: 0 self, 1 parent, 2 child, 3 sibling, 4 none, 5 end effector.
+    pub relations: Vec<Vec<u8>>,
+    /// Hop distances capped at dmax, J x J.
+    pub distances: Vec<Vec<u8>>,
+    pub chains: Vec<Vec<usize>>,
+    pub end_effectors: Vec<usize>,
+    pub feet: Vec<usize>,
+    pub foot_rule: FootRule,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RestPose {
+    /// World positions of the joints with identity rotations.
+    pub positions: Vec<[f64; 3]>,
+    pub bounds_min: [f64; 3],
+    pub bounds_max: [f64; 3],
+    /// Vertical extent (y), End Sites included.
+    pub height: f64,
+    /// Largest extent along any axis.
+    pub extent: f64,
+    pub bone_length: Option<Stats>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct MotionInfo {
+    pub frames: usize,
+    pub fps: f64,
+    pub duration_s: f64,
+    /// Vertical extent of frame 0's joint positions (BVH units).
+    pub first_frame_height: f64,
+}
+
+/// Errors reading a document back.
+#[derive(Debug, thiserror::Error)]
+pub enum DocumentError {
+    #[error("not a skeleton document: {0}")]
+    Json(#[from] serde_json::Error),
+    #[error("unsupported document: format '{format}' version {version} (expected '{FORMAT}' version {FORMAT_VERSION})")]
+    Version { format: String, version: u32 },
+    #[error("joint {joint} '{name}': {what}")]
+    Joint { joint: usize, name: String, what: String },
+    #[error("{0}")]
+    Skeleton(#[from] crate::skeleton::SkeletonError),
+}
+
+impl SkeletonDocument {
+    pub fn build(skeleton: &Skeleton, motion: Option<&Motion>, source: &str, dmax: usize) -> SkeletonDocument {
+        let normalised: Vec<String> = skeleton.joints.iter().map(|j| names::normalise(&j.name)).collect();
+        let sides = roles::sides(skeleton, &normalised);
+        let (feet, foot_rule) = roles::feet(skeleton);
+        let end_effectors = topology::end_effectors(skeleton);
+        let depths = skeleton.depths();
+        let rest = skeleton.rest_positions();
+        let (lo, hi) = skeleton.rest_bounds();
+        let joints = skeleton
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(j, joint)| JointEntry {
+                name: joint.name.clone(),
+                normalised: normalised[j].clone(),
+                parent: joint.parent,
+                offset: joint.offset.to_array(),
+                channels: joint.channels.iter().map(|c| c.name().to_string()).collect(),
+                end_sites: joint.end_sites.iter().map(|e| e.to_array()).collect(),
+                side: sides[j],
+                depth: depths[j],
+                end_effector: end_effectors.binary_search(&j).is_ok(),
+                foot: feet.binary_search(&j).is_ok(),
+            })
+            .collect();
+        let motion = motion.filter(|m| m.frames > 0).map(|m| {
+            let first = &m.forward_kinematics_frame0(skeleton);
+            let (ylo, yhi) = first.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
+            MotionInfo {
+                frames: m.frames,
+                fps: 1.0 / m.frame_time,
+                duration_s: m.frames as f64 * m.frame_time,
+                first_frame_height: yhi - ylo,
+            }
+        });
+        SkeletonDocument {
+            format: FORMAT.to_string(),
+            version: FORMAT_VERSION,
+            source: source.to_string(),
+            frame_time: skeleton.frame_time,
+            joint_count: skeleton.len(),
+            joints,
+            topology: Topology {
+                dmax,
+                relations: topology::relations(skeleton),
+                distances: topology::distances(skeleton, dmax),
+                chains: topology::kinematic_chains(skeleton),
+                end_effectors,
+                feet,
+                foot_rule,
+            },
+            rest_pose: RestPose {
+                positions: rest.iter().map(|p| p.to_array()).collect(),
+                bounds_min: lo.to_array(),
+                bounds_max: hi.to_array(),
+                height: hi.y - lo.y,
+                extent: (hi - lo).max_element(),
+                bone_length: Stats::of(&skeleton.bone_lengths()),
+            },
+            motion,
+        }
+    }
+
+    /// Parse a document and rebuild its skeleton, checking what the algorithms rely on.
+    pub fn from_json(text: &str) -> Result<SkeletonDocument, DocumentError> {
+        let doc: SkeletonDocument = serde_json::from_str(text)?;
+        if doc.format != FORMAT || doc.version != FORMAT_VERSION {
+            return Err(DocumentError::Version { format: doc.format, version: doc.version });
+        }
+        doc.skeleton()?;
+        Ok(doc)
+    }
+
+    /// The skeleton this document describes (enough to write the BVH hierarchy back).
+    pub fn skeleton(&self) -> Result<Skeleton, DocumentError> {
+        let mut joints = Vec::with_capacity(self.joints.len());
+        for (j, e) in self.joints.iter().enumerate() {
+            let bad = |what: String| DocumentError::Joint { joint: j, name: e.name.clone(), what };
+            let mut channels = Vec::with_capacity(e.channels.len());
+            for c in &e.channels {
+                channels.push(Channel::from_name(c).ok_or_else(|| bad(format!("unknown channel '{c}'")))?);
+            }
+            if e.offset.iter().chain(e.end_sites.iter().flatten()).any(|v| !v.is_finite()) {
+                return Err(bad("non-finite offset".into()));
+            }
+            joints.push(Joint {
+                name: e.name.clone(),
+                parent: e.parent,
+                offset: DVec3::from_array(e.offset),
+                channels,
+                end_sites: e.end_sites.iter().map(|v| DVec3::from_array(*v)).collect(),
+            });
+        }
+        let skeleton = Skeleton { joints, frame_time: self.frame_time };
+        skeleton.validate()?;
+        Ok(skeleton)
+    }
+}

@@ -1,0 +1,117 @@
+//! Body roles of joints that algorithms need without a per-species table: sides and feet.
+//!
+//! Names first, geometry when names say nothing. Geometry assumes the BVH convention that a
+//! skeleton's rest pose is y-up; the lateral axis is whichever horizontal axis the skeleton is
+//! mirror-symmetric about (x for most files, z for some Truebones rigs).
+
+use super::names::{self, Side};
+use super::Skeleton;
+use glam::DVec3;
+
+/// AnyTop's foot words (reference/anytop.md §1.3.7): a joint whose lower-cased raw name
+/// contains one of these is a foot candidate, and so are all of its descendants.
+const FOOT_WORDS: &[&str] = &["toe", "foot", "phalanx", "hoof", "ashi"];
+
+/// Fraction of the rest-pose height below which joints count as feet when no name says "foot".
+const GEOMETRIC_FOOT_BAND: f64 = 0.1;
+
+/// How feet were found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FootRule {
+    /// AnyTop's name rule.
+    Names,
+    /// Joints in the lowest band of the rest pose.
+    Geometry,
+}
+
+/// Foot joints (sorted) and the rule that found them.
+pub fn feet(skeleton: &Skeleton) -> (Vec<usize>, FootRule) {
+    let n = skeleton.len();
+    let mut is_foot = vec![false; n];
+    for (j, joint) in skeleton.joints.iter().enumerate() {
+        let lower = joint.name.to_lowercase();
+        let named = FOOT_WORDS.iter().any(|w| lower.contains(w));
+        // Parents precede children, so one pass propagates to all descendants.
+        let parent_is_foot = joint.parent.is_some_and(|p| is_foot[p]);
+        is_foot[j] = named || parent_is_foot;
+    }
+    if is_foot.iter().any(|&f| f) {
+        return ((0..n).filter(|&j| is_foot[j]).collect(), FootRule::Names);
+    }
+    let pos = skeleton.rest_positions();
+    let (lo, hi) = skeleton.rest_bounds();
+    let band = lo.y + GEOMETRIC_FOOT_BAND * (hi.y - lo.y).max(1e-12);
+    let feet = (0..n).filter(|&j| pos[j].y <= band && (j != 0 || n == 1)).collect();
+    (feet, FootRule::Geometry)
+}
+
+/// Left/right/centre for every joint: the name's side; else an ancestor's named side; else
+/// the side of the symmetry plane the joint lies on; else centre.
+pub fn sides(skeleton: &Skeleton, normalised: &[String]) -> Vec<Side> {
+    let n = skeleton.len();
+    let named: Vec<Option<Side>> = normalised.iter().map(|s| names::side_from_name(s)).collect();
+    let pos = skeleton.rest_positions();
+    let geometric = geometric_sides(skeleton, &pos, &named);
+    let mut out = vec![Side::Centre; n];
+    for j in 0..n {
+        out[j] = match named[j] {
+            Some(s) => s,
+            None => match skeleton.joints[j].parent.map(|p| out[p]) {
+                Some(s @ (Side::Left | Side::Right)) => s,
+                _ => geometric[j],
+            },
+        };
+    }
+    out
+}
+
+/// Sides from geometry: pick the horizontal axis about which the rest pose is most
+/// mirror-symmetric; joints clearly off that plane get a side by the sign of their coordinate.
+/// The sign convention comes from named joints when there are any, else from the BVH
+/// convention (character faces +z, so its left is +x; facing +x, its left is -z).
+fn geometric_sides(skeleton: &Skeleton, pos: &[DVec3], named: &[Option<Side>]) -> Vec<Side> {
+    let n = pos.len();
+    let root = pos[0];
+    let scale = skeleton.rest_extent().max(1e-12);
+    let tol = 0.02 * scale;
+    // Symmetry score of an axis: how many off-plane joints have a mirror partner.
+    let score = |axis: usize| -> usize {
+        (0..n)
+            .filter(|&j| (pos[j][axis] - root[axis]).abs() > tol)
+            .filter(|&j| {
+                let mut m = pos[j];
+                m[axis] = 2.0 * root[axis] - m[axis];
+                (0..n).any(|k| k != j && pos[k].distance(m) < tol)
+            })
+            .count()
+    };
+    let (sx, sz) = (score(0), score(2));
+    if sx == 0 && sz == 0 {
+        return vec![Side::Centre; n];
+    }
+    let axis = if sx >= sz { 0 } else { 2 };
+    // +1 when positive coordinates are the left side.
+    let mut vote = 0.0;
+    for j in 0..n {
+        let d = pos[j][axis] - root[axis];
+        match named[j] {
+            Some(Side::Left) => vote += d.signum(),
+            Some(Side::Right) => vote -= d.signum(),
+            _ => {}
+        }
+    }
+    let left_sign = if vote != 0.0 { vote.signum() } else if axis == 0 { 1.0 } else { -1.0 };
+    (0..n)
+        .map(|j| {
+            let d = pos[j][axis] - root[axis];
+            if d.abs() <= tol {
+                Side::Centre
+            } else if d.signum() == left_sign {
+                Side::Left
+            } else {
+                Side::Right
+            }
+        })
+        .collect()
+}
