@@ -5,6 +5,7 @@
 //! Exit codes: 0 ok; 1 a valid but negative answer; 2 usage, I/O or data error. Errors print
 //! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
+pub mod docs;
 pub mod skel_info;
 
 use std::path::PathBuf;

@@ -21,14 +21,15 @@ use std::path::PathBuf;
 /// Schema is docs/skeleton.schema.json.
 ///
 /// With --format text it prints a readable tree and a summary instead.
-///
-/// EXAMPLES:
-///     skel-info examples/data/biped.bvh --pretty
-///     skel-info examples/data/spider.bvh --format text
-///     cat examples/data/snake.bvh | skel-info - --dmax 3 -o snake.json
-///     skel-info examples/data/*.bvh | jq -r '.source + ": " + (.joint_count|tostring)'
+const EXAMPLES: &str = "\
+EXAMPLES:
+    skel-info examples/data/biped.bvh --pretty
+    skel-info examples/data/spider.bvh --format text
+    cat examples/data/snake.bvh | skel-info - --dmax 3 -o snake.json
+    skel-info examples/data/*.bvh > zoo.jsonl";
+
 #[derive(clap::Parser, Debug)]
-#[command(name = "skel-info", version, verbatim_doc_comment)]
+#[command(name = "skel-info", version, after_long_help = EXAMPLES)]
 pub struct Args {
     /// BVH files to inspect ('-' = stdin).
     #[arg(value_name = "BVH", required = true)]

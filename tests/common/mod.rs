@@ -48,7 +48,6 @@ pub fn example_bvh_files() -> Vec<PathBuf> {
 pub fn bin(name: &str) -> Command {
     let path = match name {
         "skel-info" => env!("CARGO_BIN_EXE_skel-info"),
-        "menagerie-gen" => env!("CARGO_BIN_EXE_menagerie-gen"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);
