@@ -46,19 +46,25 @@ pub fn feet(skeleton: &Skeleton) -> (Vec<usize>, FootRule) {
     (feet, FootRule::Geometry)
 }
 
-/// Left/right/centre for every joint: the name's side; else an ancestor's named side; else
-/// the side of the symmetry plane the joint lies on; else centre.
+/// Left/right/centre for every joint: the name's side; else an ancestor's named side; else,
+/// only when no joint names a side at all, the side of the symmetry plane the joint lies on;
+/// else centre. Geometry is not mixed with names because many rigs' rest poses are not
+/// upright (Bandai Namco and Truebones rigs lie along x), where an unnamed spine joint would
+/// land on a "side".
 pub fn sides(skeleton: &Skeleton, normalised: &[String]) -> Vec<Side> {
     let n = skeleton.len();
     let named: Vec<Option<Side>> = normalised.iter().map(|s| names::side_from_name(s)).collect();
-    let pos = skeleton.rest_positions();
-    let geometric = geometric_sides(skeleton, &pos, &named);
+    let geometric = if named.iter().any(Option::is_some) {
+        vec![Side::Centre; n]
+    } else {
+        geometric_sides(skeleton, &skeleton.rest_positions())
+    };
     let mut out = vec![Side::Centre; n];
     for j in 0..n {
         out[j] = match named[j] {
             Some(s) => s,
             None => match skeleton.joints[j].parent.map(|p| out[p]) {
-                Some(s @ (Side::Left | Side::Right)) => s,
+                Some(s @ (Side::Left | Side::Right)) if geometric[j] == Side::Centre || geometric[j] == s => s,
                 _ => geometric[j],
             },
         };
@@ -67,10 +73,10 @@ pub fn sides(skeleton: &Skeleton, normalised: &[String]) -> Vec<Side> {
 }
 
 /// Sides from geometry: pick the horizontal axis about which the rest pose is most
-/// mirror-symmetric; joints clearly off that plane get a side by the sign of their coordinate.
-/// The sign convention comes from named joints when there are any, else from the BVH
-/// convention (character faces +z, so its left is +x; facing +x, its left is -z).
-fn geometric_sides(skeleton: &Skeleton, pos: &[DVec3], named: &[Option<Side>]) -> Vec<Side> {
+/// mirror-symmetric; joints clearly off that plane get a side by the sign of their coordinate,
+/// following the BVH convention (a character faces +z, so its left is +x; a rig facing +x has
+/// its left at -z).
+fn geometric_sides(skeleton: &Skeleton, pos: &[DVec3]) -> Vec<Side> {
     let n = pos.len();
     let root = pos[0];
     let scale = skeleton.rest_extent().max(1e-12);
@@ -90,18 +96,7 @@ fn geometric_sides(skeleton: &Skeleton, pos: &[DVec3], named: &[Option<Side>]) -
     if sx == 0 && sz == 0 {
         return vec![Side::Centre; n];
     }
-    let axis = if sx >= sz { 0 } else { 2 };
-    // +1 when positive coordinates are the left side.
-    let mut vote = 0.0;
-    for j in 0..n {
-        let d = pos[j][axis] - root[axis];
-        match named[j] {
-            Some(Side::Left) => vote += d.signum(),
-            Some(Side::Right) => vote -= d.signum(),
-            _ => {}
-        }
-    }
-    let left_sign = if vote != 0.0 { vote.signum() } else if axis == 0 { 1.0 } else { -1.0 };
+    let (axis, left_sign) = if sx >= sz { (0, 1.0) } else { (2, -1.0) };
     (0..n)
         .map(|j| {
             let d = pos[j][axis] - root[axis];
@@ -114,4 +109,38 @@ fn geometric_sides(skeleton: &Skeleton, pos: &[DVec3], named: &[Option<Side>]) -
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh;
+
+    fn skeleton(text: &str) -> Skeleton {
+        Skeleton::from_bvh(&bvh::parse(text, "test").unwrap())
+    }
+
+    /// Root with two mirrored unnamed legs and a tail: sides come from geometry (+x = left).
+    const UNNAMED: &str = "HIERARCHY\nROOT j0\n{\nOFFSET 0 1 0\nCHANNELS 0\nJOINT j1\n{\nOFFSET 0.3 -0.5 0\nCHANNELS 0\nJOINT j2\n{\nOFFSET 0 -0.5 0\nCHANNELS 0\n}\n}\nJOINT j3\n{\nOFFSET -0.3 -0.5 0\nCHANNELS 0\nJOINT j4\n{\nOFFSET 0 -0.5 0\nCHANNELS 0\n}\n}\nJOINT j5\n{\nOFFSET 0 0 -0.8\nCHANNELS 0\n}\n}\nMOTION\nFrames: 0\nFrame Time: 0.1\n";
+
+    #[test]
+    fn geometry_gives_sides_and_feet_when_names_are_silent() {
+        let s = skeleton(UNNAMED);
+        let norm: Vec<String> = s.joints.iter().map(|j| names::normalise(&j.name)).collect();
+        let sides = sides(&s, &norm);
+        assert_eq!(sides, vec![Side::Centre, Side::Left, Side::Left, Side::Right, Side::Right, Side::Centre]);
+        let (f, rule) = feet(&s);
+        assert_eq!(rule, FootRule::Geometry);
+        assert_eq!(f, vec![2, 4]);
+    }
+
+    #[test]
+    fn names_win_and_unnamed_joints_inherit_or_stay_centre() {
+        let text = UNNAMED.replace("j1", "LeftLeg").replace("j2", "ankle").replace("j3", "Leg_R").replace("j4", "paw").replace("j5", "Tail_Foot");
+        let s = skeleton(&text);
+        let norm: Vec<String> = s.joints.iter().map(|j| names::normalise(&j.name)).collect();
+        assert_eq!(sides(&s, &norm), vec![Side::Centre, Side::Left, Side::Left, Side::Right, Side::Right, Side::Centre]);
+        // AnyTop's name rule: "foot" in the name, plus descendants.
+        assert_eq!(feet(&s), (vec![5], FootRule::Names));
+    }
 }
