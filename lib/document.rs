@@ -8,6 +8,7 @@
 //! readers ignore fields they do not know.
 
 use crate::bvh::Channel;
+use crate::bvh::Bvh;
 use crate::motion::Motion;
 use crate::skeleton::names::{self, Side};
 use crate::skeleton::roles::{self, FootRule};
@@ -84,6 +85,24 @@ pub struct MotionInfo {
     pub first_frame_height: f64,
 }
 
+impl MotionInfo {
+    /// Summary of a BVH's motion, or `None` when it has no frames. Only frame 0 is converted
+    /// and posed: building the whole motion for a summary cost more than the document itself.
+    pub fn of(bvh: &Bvh, skeleton: &Skeleton) -> Option<MotionInfo> {
+        if bvh.frames == 0 {
+            return None;
+        }
+        let first = Motion::from_bvh_frames(bvh, skeleton, 0..1).forward_kinematics(skeleton);
+        let (lo, hi) = first.positions.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
+        Some(MotionInfo {
+            frames: bvh.frames,
+            fps: 1.0 / bvh.frame_time,
+            duration_s: bvh.frames as f64 * bvh.frame_time,
+            first_frame_height: hi - lo,
+        })
+    }
+}
+
 /// Errors reading a document back.
 #[derive(Debug, thiserror::Error)]
 pub enum DocumentError {
@@ -98,7 +117,8 @@ pub enum DocumentError {
 }
 
 impl SkeletonDocument {
-    pub fn build(skeleton: &Skeleton, motion: Option<&Motion>, source: &str, dmax: usize) -> SkeletonDocument {
+    /// The document of a skeleton; `motion` (a summary, see `MotionInfo::of`) when the file had frames.
+    pub fn build(skeleton: &Skeleton, motion: Option<MotionInfo>, source: &str, dmax: usize) -> SkeletonDocument {
         let normalised: Vec<String> = skeleton.joints.iter().map(|j| names::normalise(&j.name)).collect();
         let sides = roles::sides(skeleton, &normalised);
         let (feet, foot_rule) = roles::feet(skeleton);
@@ -123,16 +143,6 @@ impl SkeletonDocument {
                 foot: feet.binary_search(&j).is_ok(),
             })
             .collect();
-        let motion = motion.filter(|m| m.frames > 0).map(|m| {
-            let first = &m.forward_kinematics_frame0(skeleton);
-            let (ylo, yhi) = first.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
-            MotionInfo {
-                frames: m.frames,
-                fps: 1.0 / m.frame_time,
-                duration_s: m.frames as f64 * m.frame_time,
-                first_frame_height: yhi - ylo,
-            }
-        });
         SkeletonDocument {
             format: FORMAT.to_string(),
             version: FORMAT_VERSION,

@@ -38,7 +38,7 @@ pub fn parse_bytes(data: &[u8], file: &str) -> Result<Bvh, BvhError> {
     let data = data.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(data);
     let mut cur = Cursor { data, pos: 0, line: 1, last_line: 1, file };
     let joints = parse_hierarchy(&mut cur)?;
-    let (frames, frame_time) = parse_motion_header(&mut cur, &joints)?;
+    let (frames, frame_time) = parse_motion_header(&mut cur)?;
     let channels: usize = joints.iter().map(|j| j.channels.len()).sum();
     let values = parse_frames(&mut cur, &joints, frames, channels)?;
     Ok(Bvh { joints, frame_time, frames, values })
@@ -56,6 +56,15 @@ struct Cursor<'a> {
 
 fn is_space(b: u8) -> bool {
     matches!(b, b' ' | b'\t' | b'\r' | b'\n' | 0x0B | 0x0C)
+}
+
+/// `s` without trailing `is_space` bytes. (`<[u8]>::trim_ascii_end` is not the same: it keeps
+/// 0x0B, which `is_space` and so the tokenizer treat as whitespace.)
+fn trim_space_end(mut s: &[u8]) -> &[u8] {
+    while let [rest @ .., last] = s {
+        if is_space(*last) { s = rest } else { break }
+    }
+    s
 }
 
 fn show(tok: &[u8]) -> String {
@@ -118,11 +127,16 @@ impl<'a> Cursor<'a> {
         }
     }
 
-    fn number(&mut self, what: &str) -> Result<f64, BvhError> {
-        let (tok, line) = self.expect_any(what)?;
+    /// A finite number. `what` names it for error messages and is only called on error: the
+    /// description includes the joint name, and building it eagerly for each of many End Sites
+    /// under a long-named joint was quadratic (a 2 MB file took a minute to parse).
+    fn number(&mut self, what: impl Fn() -> String) -> Result<f64, BvhError> {
+        let Some((tok, line)) = self.next() else {
+            return self.err(self.last_line, format!("unexpected end of file: expected {}", what()));
+        };
         match parse_f64(tok) {
             Some(v) => Ok(v),
-            None => self.err(line, format!("expected {what} (a finite number), found '{}'", show(tok))),
+            None => self.err(line, format!("expected {} (a finite number), found '{}'", what(), show(tok))),
         }
     }
 
@@ -137,10 +151,7 @@ impl<'a> Cursor<'a> {
         while let [first, rest @ ..] = s {
             if is_space(*first) { s = rest } else { break }
         }
-        while let [rest @ .., last] = s {
-            if is_space(*last) { s = rest } else { break }
-        }
-        s
+        trim_space_end(s)
     }
 }
 
@@ -160,8 +171,11 @@ impl Hierarchy {
     fn open_joint(&mut self, cur: &mut Cursor, parent: Option<usize>, line: usize) -> Result<(), BvhError> {
         let raw = cur.rest_of_line();
         // Accept `JOINT name {` on one line.
+        // Trim with `is_space`, the set `rest_of_line` trims, not `trim_ascii_end`, which keeps
+        // a vertical tab: `ROOT r\x0B{` would name the joint "r\x0B", the writer's `ROOT r\x0B`
+        // would read back as "r", and the round trip would change the name (found by fuzzing).
         let (raw, brace_inline) = match raw.strip_suffix(b"{") {
-            Some(r) => (r.trim_ascii_end(), true),
+            Some(r) => (trim_space_end(r), true),
             None => (raw, false),
         };
         if raw.is_empty() {
@@ -182,10 +196,11 @@ impl Hierarchy {
         Ok(())
     }
 
-    fn offset(cur: &mut Cursor, what: &str) -> Result<[f64; 3], BvhError> {
+    /// Three numbers; `what` describes them, lazily (see `Cursor::number`).
+    fn offset(cur: &mut Cursor, what: impl Fn() -> String) -> Result<[f64; 3], BvhError> {
         let mut o = [0.0; 3];
         for (k, v) in o.iter_mut().enumerate() {
-            *v = cur.number(&format!("{what} {}", ["x", "y", "z"][k]))?;
+            *v = cur.number(|| format!("{} {}", what(), ["x", "y", "z"][k]))?;
         }
         Ok(o)
     }
@@ -250,7 +265,7 @@ fn parse_hierarchy(cur: &mut Cursor) -> Result<Vec<BvhJoint>, BvhError> {
             if h.has_offset[j] {
                 return cur.err(line, format!("second OFFSET for joint '{}'", h.joints[j].name));
             }
-            h.joints[j].offset = Hierarchy::offset(cur, &format!("OFFSET of joint '{}':", h.joints[j].name))?;
+            h.joints[j].offset = Hierarchy::offset(cur, || format!("OFFSET of joint '{}':", h.joints[j].name))?;
             h.has_offset[j] = true;
         } else if tok.eq_ignore_ascii_case(b"CHANNELS") {
             h.channels(cur, j, line)?;
@@ -260,7 +275,7 @@ fn parse_hierarchy(cur: &mut Cursor) -> Result<Vec<BvhJoint>, BvhError> {
             cur.expect("Site", "'Site' after 'End'")?;
             cur.expect("{", "'{' opening End Site")?;
             cur.expect("OFFSET", "OFFSET inside End Site")?;
-            let o = Hierarchy::offset(cur, &format!("End Site OFFSET under joint '{}':", h.joints[j].name))?;
+            let o = Hierarchy::offset(cur, || format!("End Site OFFSET under joint '{}':", h.joints[j].name))?;
             cur.expect("}", "'}' closing End Site")?;
             h.joints[j].end_sites.push(o);
         } else if tok == b"}" {
@@ -277,7 +292,7 @@ fn parse_hierarchy(cur: &mut Cursor) -> Result<Vec<BvhJoint>, BvhError> {
     Ok(h.joints)
 }
 
-fn parse_motion_header(cur: &mut Cursor, joints: &[BvhJoint]) -> Result<(usize, f64), BvhError> {
+fn parse_motion_header(cur: &mut Cursor) -> Result<(usize, f64), BvhError> {
     let Some((tok, line)) = cur.next() else {
         return cur.err(cur.last_line, "unexpected end of file: expected 'MOTION' after the hierarchy");
     };

@@ -30,8 +30,15 @@ pub fn write_string(bvh: &Bvh) -> String {
         let pad = "\t".repeat(depth);
         if entering {
             let keyword = if joint.parent.is_none() { "ROOT" } else { "JOINT" };
-            let _ = writeln!(s, "{pad}{keyword} {}", joint.name);
-            let _ = writeln!(s, "{pad}{{");
+            if joint.name.ends_with('{') {
+                // The reader takes a trailing '{' on the name line as an inline brace, so `JOINT
+                // a{ {` names the joint "a{". Such a name must keep its brace on the same line:
+                // `JOINT a{` + `{` would read back as "a" plus a stray '{' (found by fuzzing).
+                let _ = writeln!(s, "{pad}{keyword} {} {{", joint.name);
+            } else {
+                let _ = writeln!(s, "{pad}{keyword} {}", joint.name);
+                let _ = writeln!(s, "{pad}{{");
+            }
             let _ = writeln!(s, "{pad}\tOFFSET {} {} {}", joint.offset[0], joint.offset[1], joint.offset[2]);
             let _ = write!(s, "{pad}\tCHANNELS {}", joint.channels.len());
             for c in &joint.channels {

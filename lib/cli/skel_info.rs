@@ -1,8 +1,7 @@
 //! `skel-info`: BVH -> skeleton document (JSON) or a readable tree.
 
 use crate::cli::CommonOpts;
-use crate::document::SkeletonDocument;
-use crate::motion::Motion;
+use crate::document::{MotionInfo, SkeletonDocument};
 use crate::skeleton::names::Side;
 use crate::skeleton::{topology, Skeleton};
 use crate::{bvh, io};
@@ -64,8 +63,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
         let parsed = bvh::parse_bytes(&bytes, &name)?;
         let skeleton = Skeleton::from_bvh(&parsed);
-        let motion = Motion::from_bvh(&parsed, &skeleton);
-        let doc = SkeletonDocument::build(&skeleton, Some(&motion), &name, args.dmax as usize);
+        let doc = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, args.dmax as usize);
         match args.format {
             Format::Json => {
                 let json = if args.pretty { serde_json::to_string_pretty(&doc) } else { serde_json::to_string(&doc) };

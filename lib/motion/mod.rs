@@ -43,11 +43,17 @@ impl WorldPose {
 impl Motion {
     /// Build the motion of a parsed BVH (`skeleton` must come from the same file).
     pub fn from_bvh(bvh: &Bvh, skeleton: &Skeleton) -> Motion {
+        Motion::from_bvh_frames(bvh, skeleton, 0..bvh.frames)
+    }
+
+    /// Build the motion of some frames of a parsed BVH (the range is clamped to the file).
+    pub fn from_bvh_frames(bvh: &Bvh, skeleton: &Skeleton, frames: std::ops::Range<usize>) -> Motion {
+        let frames = frames.start.min(bvh.frames)..frames.end.min(bvh.frames);
         let nj = skeleton.joints.len();
         let nc = bvh.channel_count();
-        let mut rotations = Vec::with_capacity(bvh.frames * nj);
-        let mut translations = Vec::with_capacity(bvh.frames * nj);
-        for f in 0..bvh.frames {
+        let mut rotations = Vec::with_capacity(frames.len() * nj);
+        let mut translations = Vec::with_capacity(frames.len() * nj);
+        for f in frames.clone() {
             let row = &bvh.values[f * nc..(f + 1) * nc];
             let mut at = 0;
             for joint in &skeleton.joints {
@@ -67,7 +73,7 @@ impl Motion {
                 translations.push(if has_pos { pos } else { joint.offset });
             }
         }
-        Motion { frames: bvh.frames, joints: nj, frame_time: bvh.frame_time, rotations, translations }
+        Motion { frames: frames.len(), joints: nj, frame_time: bvh.frame_time, rotations, translations }
     }
 
     /// The skeleton's rest pose as a one-frame motion (identity rotations, OFFSET translations).
@@ -126,17 +132,5 @@ impl Motion {
         }
         bvh.values = values;
         bvh
-    }
-
-    /// World positions of frame 0 only (cheap summary for documents).
-    pub fn forward_kinematics_frame0(&self, skeleton: &Skeleton) -> Vec<DVec3> {
-        let first = Motion {
-            frames: 1,
-            joints: self.joints,
-            frame_time: self.frame_time,
-            rotations: self.rotations[..self.joints].to_vec(),
-            translations: self.translations[..self.joints].to_vec(),
-        };
-        first.forward_kinematics(skeleton).positions
     }
 }

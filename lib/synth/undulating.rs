@@ -1,0 +1,168 @@
+//! Limbless movers: the snake and the fish.
+//!
+//! Both propel themselves with a wave travelling backwards along the body, which is the case
+//! that skeleton tools built for legs get wrong (no feet, a root in the middle of a long chain,
+//! motion almost all in yaw). The snake's wave must not slip on the ground, so its body follows
+//! one serpenoid path: every joint sits on the curve its head traced. A fish pushes against
+//! water and may slip, so its wave is the classic carangiform one — segment k yaws by
+//! A_k sin(2π(f t − k/λ)) with amplitude growing towards the tail — applied directly as local
+//! rotations.
+
+use super::*;
+
+/// A planar curve sampled by arc length: heading θ(s) = α cos(2π s / Λ) (the serpenoid curve,
+/// the shape real snakes take in lateral undulation), integrated once into positions.
+struct Serpenoid {
+    start: f64,
+    step: f64,
+    points: Vec<DVec3>,
+}
+
+impl Serpenoid {
+    fn new(amplitude_deg: f64, wavelength: f64, start: f64, end: f64) -> Serpenoid {
+        let step = 0.001;
+        let n = ((end - start) / step).ceil() as usize + 2;
+        // Cosine, so the lateral offset is a sine about x = 0 and the snake travels along +z.
+        let heading = |s: f64| amplitude_deg.to_radians() * cwave(s / wavelength);
+        let mut points = Vec::with_capacity(n);
+        let mut at = DVec3::ZERO;
+        for i in 0..n {
+            points.push(at);
+            // Midpoint heading: second-order accurate, plenty at a millimetre step.
+            let h = heading(start + (i as f64 + 0.5) * step);
+            at += v3(h.sin(), 0.0, h.cos()) * step;
+        }
+        // Re-anchor so that arc length 0 is at the origin.
+        let origin = Serpenoid { start, step, points: points.clone() }.at(0.0);
+        Serpenoid { start, step, points: points.into_iter().map(|p| p - origin).collect() }
+    }
+
+    fn at(&self, s: f64) -> DVec3 {
+        let x = ((s - self.start) / self.step).clamp(0.0, (self.points.len() - 2) as f64);
+        let i = x.floor() as usize;
+        self.points[i].lerp(self.points[i + 1], x - i as f64)
+    }
+}
+
+/// A snake lying on the ground, root behind the head, `jt`-prefixed names.
+pub(super) fn snake(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    const SPINE: usize = 16;
+    const TAIL: usize = 6;
+    let layout = Layout { root_order: "YZX", joint_order: "YZX", all_positions: false };
+    let radius = 0.03;
+    let mut b = Builder::new("jtRoot", v3(0.0, radius, 0.0), layout);
+    let neck = b.add("jtNeck", 0, v3(0.0, 0.0, 0.07));
+    let head = b.add("jtHead", neck, v3(0.0, 0.0, 0.06));
+    let jaw = b.add("jtJaw", head, v3(0.0, -0.01, 0.02));
+    b.end(jaw, v3(0.0, 0.0, 0.05));
+    let spine_names: Vec<String> = (1..=SPINE).map(|i| format!("jtSpine{i:02}")).collect();
+    let mut body = b.chain(&spine_names, 0, v3(0.0, 0.0, -0.07), v3(0.0, 0.0, -0.07));
+    let tail_names: Vec<String> = (1..=TAIL).map(|i| format!("jtTail{i:02}")).collect();
+    body.extend(b.chain(&tail_names, *body.last().unwrap(), v3(0.0, 0.0, -0.06), v3(0.0, 0.0, -0.055)));
+    b.end(*body.last().unwrap(), v3(0.0, 0.0, -0.05));
+    let skel = b.build();
+
+    // Arc-length position of every joint behind or ahead of the root (rest pose is straight).
+    let rest = skel.rest_positions();
+    let arc: Vec<f64> = rest.iter().map(|p| p.z - rest[0].z).collect();
+    let tail_end = arc[*body.last().unwrap()] - 0.05;
+    let jaw_end = arc[jaw] + 0.05;
+
+    let wavelength = rng.vary(0.75, 0.08);
+    let (frames, period) = frames_for(wavelength / rng.vary(0.45, 0.1), 2);
+    // No slip: the wave travels back along the body exactly as fast as the body moves forward.
+    let speed = wavelength / period;
+    let amplitude = rng.vary(38.0, 0.1);
+    let travel = speed * frames as f64 * FRAME_TIME;
+    let path = Serpenoid::new(amplitude, wavelength, tail_end - 0.1, travel + jaw_end + 0.1);
+    let lift = rng.vary(14.0, 0.2);
+    let motion = animate(&skel, frames, |p, t| {
+        let s0 = speed * t;
+        let at = |j: usize| path.at(s0 + arc[j]) + DVec3::Y * radius;
+        // Each bone is aimed along the chord to where its child lies on the path.
+        let yaw = |from: DVec3, to: DVec3, rest_dir: DVec3| {
+            let mut d = to - from;
+            d.y = 0.0;
+            aim(rest_dir, DVec3::Y, d, DVec3::Y)
+        };
+        let root_yaw = yaw(at(body[0]), at(neck), DVec3::Z);
+        p.root(at(0), root_yaw);
+        // The head and neck rise off the ground and the head looks level, flicking its jaw.
+        let neck_yaw = yaw(at(neck), at(head), DVec3::Z);
+        p.world(neck, neck_yaw * rx(-lift));
+        let head_yaw = yaw(at(head), path.at(s0 + jaw_end) + DVec3::Y * radius, DVec3::Z);
+        p.world(head, head_yaw * rx(lift * 0.8));
+        p.local(jaw, rx(6.0 * wave(2.0 * t / period).max(0.0)));
+        for (i, &j) in body.iter().enumerate() {
+            let next = if i + 1 < body.len() { at(body[i + 1]) } else { path.at(s0 + tail_end) + DVec3::Y * radius };
+            p.world(j, yaw(at(j), next, DVec3::NEG_Z));
+        }
+    });
+    (skel, motion)
+}
+
+/// A fish swimming in mid-water, snake_case names with `_L`/`_R` fins.
+pub(super) fn fish(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    let layout = Layout { root_order: "XZY", joint_order: "XZY", all_positions: false };
+    let depth = 0.5;
+    let mut b = Builder::new("spine_01", v3(0.0, depth, 0.0), layout);
+    let head = b.add("head", 0, v3(0.0, 0.0, 0.1));
+    let jaw = b.add("jaw", head, v3(0.0, -0.025, 0.04));
+    b.end(jaw, v3(0.0, 0.0, 0.06));
+    let mut fins = Vec::new();
+    for left in [true, false] {
+        let s = if left { 1.0 } else { -1.0 };
+        let fin = b.add(if left { "fin_L" } else { "fin_R" }, 0, v3(0.04 * s, -0.03, 0.03));
+        b.end(fin, v3(0.07 * s, -0.02, -0.05));
+        fins.push(fin);
+    }
+    let spine2 = b.add("spine_02", 0, v3(0.0, 0.0, -0.1));
+    let dorsal = b.add("dorsal_fin", spine2, v3(0.0, 0.06, 0.0));
+    b.end(dorsal, v3(0.0, 0.06, -0.07));
+    let spine3 = b.add("spine_03", spine2, v3(0.0, 0.0, -0.1));
+    let mut pelvic = Vec::new();
+    for left in [true, false] {
+        let s = if left { 1.0 } else { -1.0 };
+        let fin = b.add(if left { "pelvic_fin_L" } else { "pelvic_fin_R" }, spine3, v3(0.02 * s, -0.05, 0.0));
+        b.end(fin, v3(0.02 * s, -0.04, -0.05));
+        pelvic.push(fin);
+    }
+    let rest: Vec<String> = (4..=6).map(|i| format!("spine_{i:02}")).collect();
+    let mut spine = vec![spine2, spine3];
+    spine.extend(b.chain(&rest, spine3, v3(0.0, 0.0, -0.09), v3(0.0, 0.0, -0.08)));
+    let tail = b.add("tail_fin", *spine.last().unwrap(), v3(0.0, 0.0, -0.07));
+    b.end(tail, v3(0.0, 0.0, -0.1));
+    spine.push(tail);
+    let skel = b.build();
+
+    let beat = rng.vary(0.4, 0.08);
+    let (frames, period) = frames_for(beat, 8);
+    let body_length = 0.1 + 0.06 + 0.1 + 0.1 + 0.09 + 0.08 + 0.08 + 0.07 + 0.1;
+    let speed = rng.vary(0.9, 0.1) * body_length;
+    let amplitude = rng.vary(14.0, 0.1);
+    // About one body wave along the fish: λ in segments.
+    let lambda = rng.vary(5.5, 0.08);
+    let motion = animate(&skel, frames, |p, t| {
+        let c = t / period;
+        // The head recoils against the tail beat, and the body rolls a touch with it.
+        let sway = 0.006 * wave(c + 0.25);
+        p.root(v3(sway, depth + 0.004 * wave(0.5 * c), speed * t), ry(-0.35 * amplitude * wave(c)) * rz(1.5 * wave(c)));
+        p.local(head, ry(0.15 * amplitude * wave(c)));
+        p.local(jaw, rx(3.0 + 3.0 * wave(0.5 * c)));
+        for (k, &j) in spine.iter().enumerate() {
+            let x = (k + 1) as f64 / spine.len() as f64;
+            let a = amplitude * (0.25 + 0.75 * x * x);
+            p.local(j, ry(a * wave(c - (k + 1) as f64 / lambda)));
+        }
+        for (i, &f) in fins.iter().enumerate() {
+            let q = rz(20.0 * wave(c)) * ry(10.0 * cwave(c));
+            p.local(f, if i == 0 { q } else { mirror(q) });
+        }
+        for (i, &f) in pelvic.iter().enumerate() {
+            let q = rz(8.0 * wave(c - 0.3));
+            p.local(f, if i == 0 { q } else { mirror(q) });
+        }
+        p.local(dorsal, rz(5.0 * wave(c - 0.4)));
+    });
+    (skel, motion)
+}
