@@ -19,7 +19,8 @@ fn main() -> ExitCode {
         } else if let Some(v) = arg.strip_prefix("--seed=") {
             Some(v.to_string())
         } else if arg == "-h" || arg == "--help" {
-            println!("usage: zoo [OUTPUT_DIR] [--seed N]\nWrites {} as BVH into OUTPUT_DIR (default examples/data).", synth::creature_names().join(", "));
+            let names = synth::creature_names().join(", ");
+            println!("usage: zoo [OUTPUT_DIR] [--seed N]\nWrites {names} as BVH into OUTPUT_DIR (default examples/data).");
             return ExitCode::SUCCESS;
         } else if arg.starts_with('-') && arg != "-" {
             eprintln!("zoo: unknown option '{arg}' (usage: zoo [OUTPUT_DIR] [--seed N])");
@@ -46,7 +47,8 @@ fn main() -> ExitCode {
                 let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
                 let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
                 let (skeleton, motion) = synth::creature(name, seed).expect("written creatures exist");
-                println!("{}: {} joints, {} frames, {:.1} KB", path.display(), skeleton.len(), motion.frames, bytes as f64 / 1024.0);
+                let kb = bytes as f64 / 1024.0;
+                println!("{}: {} joints, {} frames, {kb:.1} KB", path.display(), skeleton.len(), motion.frames);
             }
             ExitCode::SUCCESS
         }

@@ -15,6 +15,9 @@ const FOOT_WORDS: &[&str] = &["toe", "foot", "phalanx", "hoof", "ashi"];
 /// Fraction of the rest-pose height below which joints count as feet when no name says "foot".
 const GEOMETRIC_FOOT_BAND: f64 = 0.1;
 
+/// Lowest joint this far above y = 0 (as a fraction of the creature's size): not standing.
+const GROUND_CLEARANCE: f64 = 0.25;
+
 /// How feet were found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -39,9 +42,19 @@ pub fn feet(skeleton: &Skeleton) -> (Vec<usize>, FootRule) {
     if is_foot.iter().any(|&f| f) {
         return ((0..n).filter(|&j| is_foot[j]).collect(), FootRule::Names);
     }
+    // Joints only (End Sites would put the band below the foot joints they hang from).
     let pos = skeleton.rest_positions();
-    let (lo, hi) = skeleton.rest_bounds();
-    let band = lo.y + GEOMETRIC_FOOT_BAND * (hi.y - lo.y).max(1e-12);
+    let lo = pos.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+    let hi = pos.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
+    let extent = skeleton.rest_extent().max(1e-12);
+    // A creature whose lowest joint hovers well above the ground plane (a fish, a bird in
+    // flight pose) has no feet to find.
+    if lo > GROUND_CLEARANCE * extent {
+        return (Vec::new(), FootRule::Geometry);
+    }
+    // For a flat creature (a snake) the band is measured against its length, so the whole
+    // body that rests on the ground counts, as AnyTop treats snakes.
+    let band = lo + GEOMETRIC_FOOT_BAND * (hi - lo).max(GEOMETRIC_FOOT_BAND * extent);
     let feet = (0..n).filter(|&j| pos[j].y <= band && (j != 0 || n == 1)).collect();
     (feet, FootRule::Geometry)
 }
@@ -81,14 +94,40 @@ fn geometric_sides(skeleton: &Skeleton, pos: &[DVec3]) -> Vec<Side> {
     let root = pos[0];
     let scale = skeleton.rest_extent().max(1e-12);
     let tol = 0.02 * scale;
-    // Symmetry score of an axis: how many off-plane joints have a mirror partner.
+    let parents = skeleton.parents();
+    let depth = skeleton.depths();
+    let child_count = {
+        let mut c = vec![0usize; n];
+        for p in parents.iter().flatten() {
+            c[*p] += 1;
+        }
+        c
+    };
+    // Lowest common ancestor by walking up from the deeper joint.
+    let lca = |mut a: usize, mut b: usize| -> usize {
+        while a != b {
+            if depth[a] >= depth[b] {
+                a = parents[a].unwrap_or(a);
+            } else {
+                b = parents[b].unwrap_or(b);
+            }
+            if parents[a].is_none() && parents[b].is_none() {
+                break;
+            }
+        }
+        a
+    };
+    // Symmetry score of an axis: how many off-plane joints have a mirror partner that hangs
+    // from a branching joint with a third branch (the body going on). That excludes the two
+    // halves of a body whose root sits in its middle (a snake along z is "symmetric" front to
+    // back), while left/right limbs always leave the body at a joint the spine continues from.
     let score = |axis: usize| -> usize {
         (0..n)
             .filter(|&j| (pos[j][axis] - root[axis]).abs() > tol)
             .filter(|&j| {
                 let mut m = pos[j];
                 m[axis] = 2.0 * root[axis] - m[axis];
-                (0..n).any(|k| k != j && pos[k].distance(m) < tol)
+                (0..n).any(|k| k != j && depth[k] == depth[j] && pos[k].distance(m) < tol && child_count[lca(j, k)] >= 3)
             })
             .count()
     };
@@ -142,5 +181,30 @@ mod tests {
         assert_eq!(sides(&s, &norm), vec![Side::Centre, Side::Left, Side::Left, Side::Right, Side::Right, Side::Centre]);
         // AnyTop's name rule: "foot" in the name, plus descendants.
         assert_eq!(feet(&s), (vec![5], FootRule::Names));
+    }
+
+    #[test]
+    fn a_body_with_its_root_in_the_middle_is_not_left_and_right() {
+        // A flat snake along z, root in the middle: front and back halves mirror each other
+        // about z = 0 but are not sides; all of the body on the ground counts as contact.
+        let mut text = String::from("HIERARCHY\nROOT mid\n{\nOFFSET 0 0 0\nCHANNELS 0\n");
+        for (dir, tag) in [(1.0, "f"), (-1.0, "b")] {
+            for k in 0..4 {
+                text += &format!("JOINT {tag}{k}\n{{\nOFFSET 0 0 {}\nCHANNELS 0\n", dir * 0.1);
+            }
+            text += &"}\n".repeat(4);
+        }
+        text += "}\nMOTION\nFrames: 0\nFrame Time: 0.1\n";
+        let s = skeleton(&text);
+        let norm: Vec<String> = s.joints.iter().map(|j| names::normalise(&j.name)).collect();
+        assert!(sides(&s, &norm).iter().all(|&x| x == Side::Centre));
+        let (f, rule) = feet(&s);
+        assert_eq!((f.len(), rule), (8, FootRule::Geometry));
+    }
+
+    #[test]
+    fn a_hovering_creature_has_no_geometric_feet() {
+        let text = UNNAMED.replace("OFFSET 0 1 0", "OFFSET 0 5 0");
+        assert_eq!(feet(&skeleton(&text)), (Vec::new(), FootRule::Geometry));
     }
 }

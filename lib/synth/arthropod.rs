@@ -59,16 +59,17 @@ fn jointed_leg(b: &mut Builder, parent: usize, names: [String; 4], left: bool, a
     }
 }
 
-/// Pose a jointed leg so its foot end touches `contact` (world).
-fn place_jointed_leg(p: &mut Pose, leg: &JointedLeg, contact: DVec3) {
+/// Pose a jointed leg so its foot end touches `contact` (world) with the foot held at the
+/// world rotation `foot`. Keeping the foot's rotation fixed (rather than turning it with the
+/// leg) keeps the foot joint itself still during stance, which is what contact detectors
+/// measure; the coxa then aims the leg plane at the foot joint.
+fn place_jointed_leg(p: &mut Pose, leg: &JointedLeg, contact: DVec3, foot: DQuat) {
+    let target = contact - foot * leg.end;
     let pivot = p.pos(leg.coxa);
-    let mut h = contact - pivot;
+    let mut h = target - pivot;
     h.y = 0.0;
-    let yaw = aim(leg.dir, DVec3::Y, h, DVec3::Y);
-    p.world(leg.coxa, yaw);
-    // The foot keeps the leg plane's orientation, so its end hangs straight below the tibia tip.
-    let target = contact - yaw * leg.end;
-    p.leg(&leg.ik, target, DVec3::Y, yaw);
+    p.world(leg.coxa, aim(leg.dir, DVec3::Y, h, DVec3::Y));
+    p.leg(&leg.ik, target, DVec3::Y, foot);
 }
 
 /// An eight-legged walker in alternating tetrapod gait (L1 R2 L3 R4 against R1 L2 R3 L4),
@@ -116,7 +117,7 @@ pub(super) fn spider(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         for (k, (leg, _, _)) in legs.iter().enumerate() {
             let f = gait.foot(t, touchdown[k]);
             let contact = v3(leg.home.x, f.lift, leg.home.z + f.forward);
-            place_jointed_leg(p, leg, contact);
+            place_jointed_leg(p, leg, contact, DQuat::IDENTITY);
         }
     });
     (skel, motion)
@@ -178,7 +179,11 @@ pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         }
         for (k, &(merus, carpus, finger)) in claws.iter().enumerate() {
             // Claws held up and forward, waving out of step with each other and pinching.
-            let q = [ry(-20.0) * rz(10.0 + wave_claw * wave(c + 0.5 * k as f64)), ry(35.0) * rx(-15.0), rx(-12.0 * (0.5 + 0.5 * wave(2.0 * c)))];
+            let q = [
+                ry(-20.0) * rz(10.0 + wave_claw * wave(c + 0.5 * k as f64)),
+                ry(35.0) * rx(-15.0),
+                rx(-12.0 * (0.5 + 0.5 * wave(2.0 * c))),
+            ];
             let q = if k == 0 { q } else { q.map(mirror) };
             p.local(merus, q[0]);
             p.local(carpus, q[1]);
@@ -188,7 +193,7 @@ pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
             let f = gait.foot(t, touchdown[k]);
             let home = heading * leg.home;
             let contact = v3(home.x, f.lift, home.z + f.forward);
-            place_jointed_leg(p, leg, contact);
+            place_jointed_leg(p, leg, contact, heading);
         }
     });
     (skel, motion)
@@ -201,8 +206,10 @@ pub(super) fn centipede(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     const SEGMENTS: usize = 12;
     let layout = Layout { root_order: "YXZ", joint_order: "YXZ", all_positions: false };
     let seg_len = 0.05;
-    let (attach, upper, lower) = (0.012, v3(0.05, 0.025, 0.0), v3(0.04, -0.06, 0.0));
-    let body_y = -(upper.y + lower.y);
+    // Each leg: hip (`Leg`), knee (`Shin`) raised above the body, and a short foot standing
+    // on the ground so the foot joint itself stays put in stance.
+    let (attach, upper, lower, claw) = (0.012, v3(0.05, 0.025, 0.0), v3(0.04, -0.054, 0.0), v3(0.0, -0.006, 0.0));
+    let body_y = -(upper.y + lower.y + claw.y);
     let mut b = Builder::new("Segment01", v3(0.0, body_y, 0.0), layout);
     let head = b.add("Head", 0, v3(0.0, 0.004, 0.035));
     let mut antennae = Vec::new();
@@ -222,10 +229,11 @@ pub(super) fn centipede(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         for left in [true, false] {
             let (s, side) = if left { (1.0, "L") } else { (-1.0, "R") };
             let leg = b.add(&format!("Leg{:02}_{side}", k + 1), segments[k], v3(attach * s, 0.0, 0.0));
-            let foot = b.add(&format!("Foot{:02}_{side}", k + 1), leg, v3(upper.x * s, upper.y, 0.0));
-            b.end(foot, v3(lower.x * s, lower.y, 0.0));
+            let shin = b.add(&format!("Shin{:02}_{side}", k + 1), leg, v3(upper.x * s, upper.y, 0.0));
+            let foot = b.add(&format!("Foot{:02}_{side}", k + 1), shin, v3(lower.x * s, lower.y, 0.0));
+            b.end(foot, claw);
             let home = v3((attach + upper.x + lower.x) * s, 0.0, -seg_len * k as f64);
-            legs.push((Leg { upper: leg, lower: foot, tip: None, rest_pole: DVec3::Y }, home, k, left));
+            legs.push((Leg { upper: leg, lower: shin, tip: Some(foot), rest_pole: DVec3::Y }, home, k, left));
         }
     }
     let tail = b.add("Tail", segments[SEGMENTS - 1], v3(0.0, 0.0, -seg_len));
@@ -262,7 +270,7 @@ pub(super) fn centipede(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         for (i, (leg, home, _, _)) in legs.iter().enumerate() {
             let f = gait.foot(t, touchdown[i]);
             let contact = v3(home.x, f.lift, home.z + f.forward);
-            p.leg(leg, contact, DVec3::Y, DQuat::IDENTITY);
+            p.leg(leg, contact - claw, DVec3::Y, DQuat::IDENTITY);
         }
     });
     (skel, motion)

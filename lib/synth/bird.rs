@@ -77,8 +77,10 @@ pub(super) fn bird(rng: &mut SplitMix64) -> (Skeleton, Motion) {
             let v = (phi - hold) / (1.0 - hold);
             v - wave(v) / std::f64::consts::TAU
         };
-        let head_z = gait.speed() * step * (n + g + hold / 2.0) + head_rest.z + 0.015;
-        let head_y = root_y + head_rest.y - 0.01 + 0.004 * cwave(2.0 * c);
+        // The rest neck is straight, so the head is held a little low and back: the neck
+        // then stays bent and the IK never runs out of reach.
+        let head_z = gait.speed() * step * (n + g + hold / 2.0) + head_rest.z;
+        let head_y = root_y + head_rest.y - 0.022 + 0.003 * cwave(2.0 * c);
         p.leg(&neck_leg, v3(x, head_y, head_z), DVec3::NEG_Z, DQuat::IDENTITY);
         // Wings: two flaps per stride, the hand lagging the arm as real wing tips do.
         for (i, w) in wings.iter().enumerate() {

@@ -46,13 +46,19 @@ pub(super) fn biped(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     let (frames, period) = frames_for(rng.vary(1.1, 0.06), 3);
     let gait = Gait { period, duty: rng.vary(0.6, 0.03), stride: rng.vary(1.05, 0.08), lift: rng.vary(0.07, 0.1) };
     let touchdown = [0.0, 0.5 + rng.range(-0.02, 0.02)];
-    let (ankle_y, hip_drop, bob) = (0.08, 0.06, 0.012);
+    let (ankle_y, hip_drop) = (0.08, 0.06);
     // The ball of the foot (toe base) is what stays planted: the heel rises about it late in
     // stance, which lets the trailing leg stay long, so the leading leg at heel strike is the
     // one that limits the pelvis height. 0.975 leaves room for the pelvis yaw and lean.
     let ball = skel.joints[legs[0].1].offset;
     let heel_rise = rng.vary(22.0, 0.1);
-    let root_y = ankle_y + stand_height(0.84, gait.half_reach(), 0.975) + hip_drop - bob;
+    let strike_y = ankle_y + stand_height(0.84, gait.half_reach(), 0.975) + hip_drop;
+    // The pelvis vaults over the standing leg: highest at mid-stance, where the leg is
+    // vertical and may be almost straight, lowest at double support (0.81 = the bob wave's
+    // value at touchdown, just before its minimum).
+    let mid_y = ankle_y + 0.84 * 0.97 + hip_drop;
+    let bob = (mid_y - strike_y) / 1.81;
+    let root_y = mid_y - bob;
     let yaw_amp = rng.vary(5.0, 0.2);
     let arm_amp = rng.vary(18.0, 0.15);
     let lean = rng.vary(4.0, 0.25);
@@ -257,7 +263,8 @@ fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
     let mut neck = Vec::new();
     for i in 0..spec.neck {
         let len = spec.neck_length * k / spec.neck as f64;
-        parent = b.add(&name(Part::Neck(i), None), parent, v3(0.0, 0.7 * len, 0.7 * len + if i == 0 { 0.03 * k } else { 0.0 }));
+        let reach = 0.7 * len + if i == 0 { 0.03 * k } else { 0.0 };
+        parent = b.add(&name(Part::Neck(i), None), parent, v3(0.0, 0.7 * len, reach));
         neck.push(parent);
     }
     let head = b.add(&name(Part::Head, None), parent, v3(0.0, 0.05 * k, 0.06 * k));
@@ -280,7 +287,8 @@ fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
         let toe = b.add(&name(parts[3], Some(left)), foot, v3(0.0, -0.04 * k, 0.04 * k));
         b.end(toe, v3(0.0, -0.02 * k, 0.03 * k));
         let pole = if front { DVec3::NEG_Z } else { DVec3::Z };
-        legs.push((Leg { upper: up, lower: mid, tip: Some(foot), rest_pole: pole }, half_width * s, if front { body } else { 0.0 }, pole));
+        let home_z = if front { body } else { 0.0 };
+        legs.push((Leg { upper: up, lower: mid, tip: Some(foot), rest_pole: pole }, half_width * s, home_z, pole));
     };
     let mut wings = Vec::new();
     if spec.wings {

@@ -44,29 +44,30 @@ impl Serpenoid {
     }
 }
 
-/// A snake lying on the ground, root behind the head, `jt`-prefixed names.
+/// A snake on the ground with its head raised, `jt`-prefixed names. The root is the head, as
+/// in many snake rigs; a root in mid-body would also make the straight rest pose look
+/// mirror-symmetric front to back to the geometric side rule.
 pub(super) fn snake(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     const SPINE: usize = 16;
     const TAIL: usize = 6;
     let layout = Layout { root_order: "YZX", joint_order: "YZX", all_positions: false };
     let radius = 0.03;
-    let mut b = Builder::new("jtRoot", v3(0.0, radius, 0.0), layout);
-    let neck = b.add("jtNeck", 0, v3(0.0, 0.0, 0.07));
-    let head = b.add("jtHead", neck, v3(0.0, 0.0, 0.06));
-    let jaw = b.add("jtJaw", head, v3(0.0, -0.01, 0.02));
+    let mut b = Builder::new("jtHead", v3(0.0, radius, 0.0), layout);
+    let jaw = b.add("jtJaw", 0, v3(0.0, -0.01, 0.02));
     b.end(jaw, v3(0.0, 0.0, 0.05));
+    let neck = b.add("jtNeck", 0, v3(0.0, 0.0, -0.06));
     let spine_names: Vec<String> = (1..=SPINE).map(|i| format!("jtSpine{i:02}")).collect();
-    let mut body = b.chain(&spine_names, 0, v3(0.0, 0.0, -0.07), v3(0.0, 0.0, -0.07));
+    let mut body = vec![neck];
+    body.extend(b.chain(&spine_names, neck, v3(0.0, 0.0, -0.07), v3(0.0, 0.0, -0.07)));
     let tail_names: Vec<String> = (1..=TAIL).map(|i| format!("jtTail{i:02}")).collect();
     body.extend(b.chain(&tail_names, *body.last().unwrap(), v3(0.0, 0.0, -0.06), v3(0.0, 0.0, -0.055)));
     b.end(*body.last().unwrap(), v3(0.0, 0.0, -0.05));
     let skel = b.build();
 
-    // Arc-length position of every joint behind or ahead of the root (rest pose is straight).
+    // Arc length of every joint behind the head (the rest pose is straight along -z).
     let rest = skel.rest_positions();
     let arc: Vec<f64> = rest.iter().map(|p| p.z - rest[0].z).collect();
     let tail_end = arc[*body.last().unwrap()] - 0.05;
-    let jaw_end = arc[jaw] + 0.05;
 
     let wavelength = rng.vary(0.75, 0.08);
     let (frames, period) = frames_for(wavelength / rng.vary(0.45, 0.1), 2);
@@ -74,28 +75,21 @@ pub(super) fn snake(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     let speed = wavelength / period;
     let amplitude = rng.vary(38.0, 0.1);
     let travel = speed * frames as f64 * FRAME_TIME;
-    let path = Serpenoid::new(amplitude, wavelength, tail_end - 0.1, travel + jaw_end + 0.1);
-    let lift = rng.vary(14.0, 0.2);
+    let path = Serpenoid::new(amplitude, wavelength, tail_end - 0.1, travel + 0.1);
+    let head_lift = rng.vary(0.04, 0.2);
+    // The head and neck ride above the path, the body lies on it.
+    let height = |a: f64| radius + head_lift * smoothstep((a + 0.2) / 0.14);
     let motion = animate(&skel, frames, |p, t| {
         let s0 = speed * t;
-        let at = |j: usize| path.at(s0 + arc[j]) + DVec3::Y * radius;
-        // Each bone is aimed along the chord to where its child lies on the path.
-        let yaw = |from: DVec3, to: DVec3, rest_dir: DVec3| {
-            let mut d = to - from;
-            d.y = 0.0;
-            aim(rest_dir, DVec3::Y, d, DVec3::Y)
-        };
-        let root_yaw = yaw(at(body[0]), at(neck), DVec3::Z);
-        p.root(at(0), root_yaw);
-        // The head and neck rise off the ground and the head looks level, flicking its jaw.
-        let neck_yaw = yaw(at(neck), at(head), DVec3::Z);
-        p.world(neck, neck_yaw * rx(-lift));
-        let head_yaw = yaw(at(head), path.at(s0 + jaw_end) + DVec3::Y * radius, DVec3::Z);
-        p.world(head, head_yaw * rx(lift * 0.8));
+        let at = |a: f64| path.at(s0 + a) + DVec3::Y * height(a);
+        let flat = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
+        // The head stays level, looking along the path; it flicks its jaw twice per wave.
+        p.root(at(0.0), aim(DVec3::NEG_Z, DVec3::Y, flat(at(arc[neck]) - at(0.0)), DVec3::Y));
         p.local(jaw, rx(6.0 * wave(2.0 * t / period).max(0.0)));
+        // Each bone is aimed along the chord to where its child lies on the path.
         for (i, &j) in body.iter().enumerate() {
-            let next = if i + 1 < body.len() { at(body[i + 1]) } else { path.at(s0 + tail_end) + DVec3::Y * radius };
-            p.world(j, yaw(at(j), next, DVec3::NEG_Z));
+            let next = if i + 1 < body.len() { arc[body[i + 1]] } else { tail_end };
+            p.world(j, aim(DVec3::NEG_Z, DVec3::Y, at(next) - at(arc[j]), DVec3::Y));
         }
     });
     (skel, motion)
