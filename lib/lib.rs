@@ -3,10 +3,12 @@
 //! The library behind the binaries in `bins/`: data types at the bottom (`bvh`, `skeleton`,
 //! `motion`), then documents and I/O (`document`, `io`), then tools (`synth`, `cli`).
 
+pub mod augment;
 pub mod bvh;
 pub mod cli;
 pub mod document;
 pub mod io;
 pub mod motion;
+pub mod repr;
 pub mod skeleton;
 pub mod synth;

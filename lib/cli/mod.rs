@@ -6,6 +6,8 @@
 //! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
 pub mod docs;
+pub mod mo_encode;
+pub mod skel_aug;
 pub mod skel_info;
 
 use std::path::PathBuf;
@@ -76,5 +78,5 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 /// Every tool's clap command, for man pages, completions and help tests.
 pub fn all_commands() -> Vec<clap::Command> {
     use clap::CommandFactory;
-    vec![skel_info::Args::command()]
+    vec![skel_info::Args::command(), skel_aug::Args::command(), mo_encode::Args::command()]
 }

@@ -56,3 +56,29 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     }
     result
 }
+
+/// Output path for item `i` of a batch: `{i}` in the pattern is replaced by the index.
+/// A batch of more than one item needs the placeholder, so files never overwrite each other.
+pub fn numbered_output(pattern: &Path, i: usize, count: usize) -> Result<PathBuf, String> {
+    let text = pattern.to_string_lossy();
+    if text.contains("{i}") {
+        Ok(PathBuf::from(text.replace("{i}", &i.to_string())))
+    } else if count <= 1 {
+        Ok(pattern.to_path_buf())
+    } else {
+        Err(format!("{count} outputs need a numbered output path such as 'out_{{i}}.bvh', got '{text}'"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::numbered_output;
+    use std::path::Path;
+
+    #[test]
+    fn numbered_outputs() {
+        assert_eq!(numbered_output(Path::new("a_{i}.bvh"), 3, 5).unwrap(), Path::new("a_3.bvh"));
+        assert_eq!(numbered_output(Path::new("a.bvh"), 0, 1).unwrap(), Path::new("a.bvh"));
+        assert!(numbered_output(Path::new("a.bvh"), 0, 2).is_err());
+    }
+}

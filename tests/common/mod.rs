@@ -48,6 +48,8 @@ pub fn example_bvh_files() -> Vec<PathBuf> {
 pub fn bin(name: &str) -> Command {
     let path = match name {
         "skel-info" => env!("CARGO_BIN_EXE_skel-info"),
+        "skel-aug" => env!("CARGO_BIN_EXE_skel-aug"),
+        "mo-encode" => env!("CARGO_BIN_EXE_mo-encode"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);

@@ -1,0 +1,1 @@
+//! Feature encodings of a Motion: work in progress.
