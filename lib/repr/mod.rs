@@ -1,1 +1,43 @@
-//! Feature encodings of a Motion: work in progress.
+//! Feature encodings of a Motion: the tensors learned models and metrics see.
+//!
+//! Every encoding produces `Features`, a dense `[frames, joints, dims]` float32 tensor (the
+//! layout of our NPY files), and can decode it back to a `Motion` on the same skeleton.
+//! Encodings live in their own modules (`m2m`: Motion2Motion's local 6D rotations + root
+//! motion; `anytop`: AnyTop's 13-D per-joint features).
+
+/// A `[frames, joints, dims]` float32 tensor, row-major (dims fastest).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Features {
+    pub frames: usize,
+    pub joints: usize,
+    pub dims: usize,
+    pub data: Vec<f32>,
+}
+
+impl Features {
+    pub fn zeros(frames: usize, joints: usize, dims: usize) -> Features {
+        Features { frames, joints, dims, data: vec![0.0; frames * joints * dims] }
+    }
+
+    pub fn shape(&self) -> [usize; 3] {
+        [self.frames, self.joints, self.dims]
+    }
+
+    /// The feature vector of one joint at one frame.
+    pub fn at(&self, frame: usize, joint: usize) -> &[f32] {
+        let i = (frame * self.joints + joint) * self.dims;
+        &self.data[i..i + self.dims]
+    }
+
+    pub fn at_mut(&mut self, frame: usize, joint: usize) -> &mut [f32] {
+        let i = (frame * self.joints + joint) * self.dims;
+        &mut self.data[i..i + self.dims]
+    }
+
+    /// Index of the first non-finite value, if any (features from files must be checked).
+    pub fn first_non_finite(&self) -> Option<(usize, usize, usize)> {
+        let k = self.data.iter().position(|v| !v.is_finite())?;
+        let per_frame = self.joints * self.dims;
+        Some((k / per_frame, (k % per_frame) / self.dims, k % self.dims))
+    }
+}
