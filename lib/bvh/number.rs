@@ -15,6 +15,17 @@ const POW10: [f64; 23] = [
 /// Returns `None` for anything else, including `nan`, `inf` and empty text, because a
 /// non-finite channel value is never meaningful in a BVH file.
 pub fn parse_f64(s: &[u8]) -> Option<f64> {
+    match parse_f64_prefix(s) {
+        Some((v, len)) if len == s.len() => Some(v),
+        _ => None,
+    }
+}
+
+/// Parse the number that starts `s`: its value and how many bytes its text takes. The scan is
+/// the one `parse_f64` uses, stopping where the number's text ends instead of requiring that to
+/// be the end of `s`, so `parse_f64(t) == Some(v)` exactly when this returns `Some((v, t.len()))`.
+/// It lets the frame reader find and parse a value in a single pass over the bytes.
+pub(super) fn parse_f64_prefix(s: &[u8]) -> Option<(f64, usize)> {
     let mut i = 0;
     let neg = match s.first() {
         Some(b'-') => {
@@ -27,43 +38,35 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
         }
         _ => false,
     };
+    // Digits on both sides of the point go into one integer, with one test per byte: the count
+    // of digits comes from positions, not from per-digit bookkeeping, since this loop is most of
+    // the frame section's parse time. Past 19 digits the sum may wrap; that case is sorted out
+    // below, before the mantissa is trusted.
+    let digits_start = i;
     let mut mantissa: u64 = 0;
-    let mut digits = 0usize; // significant digits accumulated into mantissa
-    let mut any_digit = false;
-    let mut exp10: i64 = 0;
-    let mut overflow = false;
-    while i < s.len() && s[i].is_ascii_digit() {
-        any_digit = true;
-        if digits < 19 {
-            mantissa = mantissa * 10 + (s[i] - b'0') as u64;
-            if mantissa != 0 {
-                digits += 1;
-            }
-        } else {
-            overflow = true;
-            exp10 += 1;
-        }
+    while let Some(d) = s.get(i).map(|c| c.wrapping_sub(b'0')).filter(|&d| d <= 9) {
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(d as u64);
         i += 1;
     }
-    if i < s.len() && s[i] == b'.' {
+    let int_digits = i - digits_start;
+    let mut frac_digits = 0;
+    if s.get(i) == Some(&b'.') {
         i += 1;
-        while i < s.len() && s[i].is_ascii_digit() {
-            any_digit = true;
-            if digits < 19 {
-                mantissa = mantissa * 10 + (s[i] - b'0') as u64;
-                if mantissa != 0 {
-                    digits += 1;
-                }
-                exp10 -= 1;
-            } else {
-                overflow = true;
-            }
+        let frac_start = i;
+        while let Some(d) = s.get(i).map(|c| c.wrapping_sub(b'0')).filter(|&d| d <= 9) {
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(d as u64);
             i += 1;
         }
+        frac_digits = i - frac_start;
     }
-    if !any_digit {
+    if int_digits + frac_digits == 0 {
         return None;
     }
+    // Leading zeros (`0.000012`) add nothing to the sum, so it is exact unless there are more
+    // than 19 significant digits (10^19 < 2^64). Only long numbers pay for counting them.
+    let exact = int_digits + frac_digits <= 19
+        || s[digits_start..i].iter().filter(|&&c| c != b'.').skip_while(|&&c| c == b'0').count() <= 19;
+    let mut exp10 = -(frac_digits as i64);
     if i < s.len() && (s[i] == b'e' || s[i] == b'E') {
         i += 1;
         let mut eneg = false;
@@ -84,18 +87,15 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
         }
         exp10 += if eneg { -e } else { e };
     }
-    if i != s.len() {
-        return None;
-    }
-    if !overflow && mantissa < (1u64 << 53) && exp10.abs() <= 22 {
+    if exact && mantissa < (1u64 << 53) && exp10.abs() <= 22 {
         let m = mantissa as f64;
         let v = if exp10 >= 0 { m * POW10[exp10 as usize] } else { m / POW10[(-exp10) as usize] };
-        return Some(if neg { -v } else { v });
+        return Some((if neg { -v } else { v }, i));
     }
     // Slow but correctly rounded; the text is ASCII by construction here.
-    let text = std::str::from_utf8(s).ok()?;
+    let text = std::str::from_utf8(&s[..i]).ok()?;
     let v: f64 = text.parse().ok()?;
-    v.is_finite().then_some(v)
+    v.is_finite().then_some((v, i))
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 //! stack), and the header's frame count is checked against the bytes that follow before any
 //! frame memory is reserved.
 
-use super::{number::parse_f64, Bvh, BvhError, BvhJoint, Channel};
+use super::{number::{parse_f64, parse_f64_prefix}, Bvh, BvhError, BvhJoint, Channel};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -359,58 +359,61 @@ fn parse_frames(cur: &mut Cursor, joints: &[BvhJoint], frames: usize, channels: 
     // how many values can really follow, whatever the header claims.
     let room = (d.len() - cur.pos.min(d.len())) / 2 + 1;
     let mut values = Vec::with_capacity(frames.saturating_mul(channels).min(room));
+    // One pass over the bytes: '\n' ends a row, other whitespace separates values, and each value
+    // is parsed where it starts, its end found by the number parser itself. Finding each line,
+    // then each token, then parsing it read every byte three times, and the two extra scans were
+    // about 40% of the parse time (BENCHMARKS.md). Errors, and the lines they name, are the same
+    // as with that line-by-line read.
     let mut row = 0;
-    let mut pos = cur.pos;
+    let mut count = 0usize; // values read so far in the current row
     let mut line = cur.line;
-    while pos < d.len() {
-        let end = d[pos..].iter().position(|&b| b == b'\n').map_or(d.len(), |k| pos + k);
-        let text = &d[pos..end];
-        let mut count = 0usize;
-        let mut i = 0;
-        while i < text.len() {
-            while i < text.len() && is_space(text[i]) {
-                i += 1;
-            }
-            if i == text.len() {
-                break;
-            }
-            let start = i;
-            while i < text.len() && !is_space(text[i]) {
-                i += 1;
-            }
-            if row == frames {
-                return cur.err(line, format!("more frame rows than 'Frames: {frames}' announced"));
-            }
-            if count == channels {
-                return cur.err(line, format!("frame {} has more than the {channels} values the hierarchy declares", row + 1));
-            }
-            match parse_f64(&text[start..i]) {
-                Some(v) => values.push(v),
-                None => {
-                    let (joint, chan) = channel_at(joints, count);
-                    return cur.err(
-                        line,
-                        format!(
-                            "frame {}: expected a finite number for {chan} of joint '{joint}' (value {} of {channels}), found '{}'",
-                            row + 1,
-                            count + 1,
-                            show(&text[start..i])
-                        ),
-                    );
-                }
-            }
-            count += 1;
+    let mut line_start = cur.pos;
+    let mut i = cur.pos;
+    while i < d.len() {
+        let b = d[i];
+        if b == b'\n' {
+            end_row(cur, line, &mut row, &mut count, channels)?;
+            i += 1;
+            line += 1;
+            line_start = i;
+            continue;
         }
-        if count != 0 {
-            if count != channels {
+        if is_space(b) {
+            i += 1;
+            continue;
+        }
+        if row == frames {
+            return cur.err(line, format!("more frame rows than 'Frames: {frames}' announced"));
+        }
+        if count == channels {
+            return cur.err(line, format!("frame {} has more than the {channels} values the hierarchy declares", row + 1));
+        }
+        match parse_f64_prefix(&d[i..]) {
+            // A number is only a value if whitespace or the end of the file follows it; `1.5x`
+            // parses as far as `1.5` and is then reported whole, like any other bad token.
+            Some((v, len)) if d.get(i + len).is_none_or(|&c| is_space(c)) => {
+                values.push(v);
+                i += len;
+            }
+            _ => {
+                let end = d[i..].iter().position(|&c| is_space(c)).map_or(d.len(), |k| i + k);
+                let (joint, chan) = channel_at(joints, count);
                 return cur.err(
                     line,
-                    format!("frame {} has {count} values, expected {channels} (one per channel)", row + 1),
+                    format!(
+                        "frame {}: expected a finite number for {chan} of joint '{joint}' (value {} of {channels}), found '{}'",
+                        row + 1,
+                        count + 1,
+                        show(&d[i..end])
+                    ),
                 );
             }
-            row += 1;
         }
-        pos = end + 1;
+        count += 1;
+    }
+    // A last line without a final newline.
+    if line_start < d.len() {
+        end_row(cur, line, &mut row, &mut count, channels)?;
         line += 1;
     }
     if row != frames {
@@ -420,6 +423,19 @@ fn parse_frames(cur: &mut Cursor, joints: &[BvhJoint], frames: usize, channels: 
         );
     }
     Ok(values)
+}
+
+/// At the end of a frame-section line: a line with values is a row and must be complete; a blank
+/// line is skipped.
+fn end_row(cur: &Cursor, line: usize, row: &mut usize, count: &mut usize, channels: usize) -> Result<(), BvhError> {
+    if *count != 0 {
+        if *count != channels {
+            return cur.err(line, format!("frame {} has {count} values, expected {channels} (one per channel)", *row + 1));
+        }
+        *row += 1;
+        *count = 0;
+    }
+    Ok(())
 }
 
 /// Which joint and channel the `k`-th value of a frame row belongs to (for error messages).

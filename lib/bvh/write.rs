@@ -10,6 +10,10 @@ use super::Bvh;
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
+/// Indentation stops growing past this depth: readers ignore it, and a pathological
+/// 20,000-deep chain would otherwise write gigabytes of tabs (quadratic in depth).
+const MAX_INDENT: usize = 32;
+
 /// Write `bvh` as BVH text.
 pub fn write(bvh: &Bvh, out: &mut impl Write) -> io::Result<()> {
     out.write_all(write_string(bvh).as_bytes())
@@ -27,7 +31,7 @@ pub fn write_string(bvh: &Bvh) -> String {
         (0..bvh.joints.len()).rev().filter(|&j| bvh.joints[j].parent.is_none()).map(|j| (j, 0, true)).collect();
     while let Some((j, depth, entering)) = stack.pop() {
         let joint = &bvh.joints[j];
-        let pad = "\t".repeat(depth);
+        let pad = "\t".repeat(depth.min(MAX_INDENT));
         if entering {
             let keyword = if joint.parent.is_none() { "ROOT" } else { "JOINT" };
             if joint.name.ends_with('{') {
@@ -81,4 +85,27 @@ fn children_of(bvh: &Bvh) -> Vec<Vec<usize>> {
         }
     }
     children
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn deep_chains_round_trip_with_bounded_indentation() {
+        let depth = 500;
+        let mut text = String::from("HIERARCHY\n");
+        for k in 0..depth {
+            text += &format!("{} j{k}\n{{\nOFFSET 0 1 0\nCHANNELS 1 Zrotation\n", if k == 0 { "ROOT" } else { "JOINT" });
+        }
+        text += &"}\n".repeat(depth);
+        text += "MOTION\nFrames: 1\nFrame Time: 0.5\n";
+        text += &vec!["1.5"; depth].join(" ");
+        let a = crate::bvh::parse(&text, "deep").unwrap();
+        let written = write_string(&a);
+        assert!(written.lines().all(|l| l.len() < MAX_INDENT + 40), "indentation must stay bounded");
+        let b = crate::bvh::parse(&written, "deep").unwrap();
+        assert_eq!(a, b);
+        assert_eq!(write_string(&b), written);
+    }
 }
