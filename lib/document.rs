@@ -106,7 +106,8 @@ impl MotionInfo {
 /// Errors reading a document back.
 #[derive(Debug, thiserror::Error)]
 pub enum DocumentError {
-    #[error("not a skeleton document: {0}")]
+    // The serde message is the source, so `{:#}` prints it once, after this.
+    #[error("not a skeleton document")]
     Json(#[from] serde_json::Error),
     #[error("unsupported document: format '{format}' version {version} (expected '{FORMAT}' version {FORMAT_VERSION})")]
     Version { format: String, version: u32 },

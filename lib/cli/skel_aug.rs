@@ -1,17 +1,249 @@
-//! `skel-aug`: work in progress.
+//! `skel-aug`: skeletal augmentation of a BVH (motion carried over exactly) or a skeleton
+//! document.
 
+use crate::augment::{self, Plan, RemoveAmount};
 use crate::cli::CommonOpts;
+use crate::document::SkeletonDocument;
+use crate::skeleton::Skeleton;
+use crate::synth::SplitMix64;
+use crate::{bvh, io};
+use anyhow::{bail, Context};
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
-/// skel-aug (work in progress).
+const EXAMPLES: &str = "\
+EXAMPLES:
+    skel-aug examples/data/biped.bvh --seed 1 -v -o biped_aug.bvh
+    skel-aug examples/data/dragon.bvh --remove-rate 0.2 --add 3 -n 4 -o 'dragon_{i}.bvh'
+    skel-aug examples/data/spider.bvh --no-remove --add 5 | skel-info - --format text
+    skel-info examples/data/quadruped.bvh | skel-aug --seed 7 --pretty
+    skel-aug examples/data/snake.bvh --allow-feet --remove-rate 0.2 -o snake_short.bvh
+    cat examples/data/crab.bvh | skel-aug -n 3 -o 'crab_{i}.bvh'";
+
+/// Augment a skeleton: remove end-effector chains, subdivide bones, keep the motion exact.
+///
+/// Reads one BVH file or skeleton document (JSON, recognised by a leading '{') and writes the
+/// same kind back with a changed skeleton (AnyTop's skeletal augmentation, done as a real
+/// edit of the hierarchy):
+///
+/// Remove (default): drop a fraction of the joints (--remove-rate, else a count drawn from the
+/// seed between 10% and 30% of the joints) by cutting chains that end in end effectors. A chain
+/// runs from an end effector up to, not including, the first joint that has several children,
+/// is a foot or is the root; whole chains are taken in random order, and at most one is cut
+/// short from its leaf end to hit the count. Feet, the root and branching joints are never
+/// removed, so some skeletons (a centipede, whose legs all end in feet) cannot lose 10%; a
+/// warning says so. The parent of a removed chain becomes an end effector and gets an End Site
+/// where the removed bone ended.
+///
+/// Add (--add N, after any removal): insert N joints, each at the midpoint of a random bone:
+/// the new joint (named <child>_mid) hangs from the bone's parent and the old joint from it,
+/// the OFFSET is split in half, and the new joint has identity rotation in every frame, with
+/// rotation channels in the split joint's Euler order. A split joint with position channels has
+/// them shifted by the new OFFSET.
+///
+/// Every surviving joint keeps its exact world position in every frame; unchanged channels are
+/// copied value for value. Joint order stays the file's (parents first, original order kept).
+/// A skeleton document comes back rebuilt: names, sides, feet, R, D, chains and end effectors of
+/// the new skeleton, with the input document's dmax. Its motion summary is dropped when the skeleton
+/// changed (it needs the frames).
+///
+/// -n K writes K variants, each with its own random choices, to -o PATTERN where '{i}' becomes
+/// 0..K-1. The same input, flags and --seed give byte-identical output.
 #[derive(clap::Parser, Debug)]
 #[command(name = "skel-aug", version, after_long_help = EXAMPLES)]
 pub struct Args {
+    /// BVH file or skeleton document (JSON) to augment ('-' = stdin).
+    #[arg(value_name = "INPUT", default_value = "-")]
+    pub input: PathBuf,
+    /// Remove this fraction of the joints, in (0, 1), rounded, at least one [default: a count
+    /// between 10% and 30% of the joints, drawn from the seed].
+    #[arg(long, value_name = "R", allow_negative_numbers = true, conflicts_with = "no_remove")]
+    pub remove_rate: Option<f64>,
+    /// Remove nothing (to only --add).
+    #[arg(long)]
+    pub no_remove: bool,
+    /// Insert N joints, each at the midpoint of a random bone (after any removal).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub add: usize,
+    /// Let removal take feet too (for bodies that lie on the ground, like snakes, whose joints
+    /// are all feet; AnyTop does the same for its snakes).
+    #[arg(long)]
+    pub allow_feet: bool,
+    /// Write K variants with different random choices (-o must then contain '{i}').
+    #[arg(short = 'n', long = "variants", value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub variants: u64,
+    /// Indent JSON output for humans (skeleton documents only).
+    #[arg(long)]
+    pub pretty: bool,
     #[command(flatten)]
     pub common: CommonOpts,
 }
 
-const EXAMPLES: &str = "EXAMPLES:\n    skel-aug --version";
+/// What came in: the output is of the same kind.
+enum Input {
+    Bvh(bvh::Bvh),
+    Document(Box<SkeletonDocument>),
+}
 
-pub fn run(_args: &Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    args.common.init_threads();
+    let options = options(args)?;
+    let count = usize::try_from(args.variants).context("too many variants")?;
+    // Output paths first: a bad pattern fails before any work and before any output.
+    let outputs = output_paths(args.common.output.as_deref(), count)?;
+
+    let name = io::display_name(&args.input);
+    let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
+    let input = if looks_like_json(&bytes) {
+        let text = std::str::from_utf8(&bytes).map_err(|e| anyhow::anyhow!("{name}: not UTF-8 text: {e}"))?;
+        Input::Document(Box::new(SkeletonDocument::from_json(text).with_context(|| name.clone())?))
+    } else {
+        Input::Bvh(bvh::parse_bytes(&bytes, &name)?)
+    };
+    let skeleton = match &input {
+        Input::Bvh(b) => Skeleton::from_bvh(b),
+        Input::Document(d) => d.skeleton().map_err(|e| anyhow::anyhow!("{name}: {e}"))?,
+    };
+
+    let mut warned = BTreeSet::new();
+    for (i, out) in outputs.iter().enumerate() {
+        let mut rng = variant_rng(args.common.seed, i);
+        let plan = augment::plan(&skeleton, &options, &mut rng);
+        let target = out.as_deref().map_or("stdout".to_string(), |p| p.display().to_string());
+        if !args.common.quiet {
+            for w in warnings(&plan, &skeleton, args.add, options.keep_feet) {
+                if warned.insert(w.clone()) {
+                    eprintln!("skel-aug: warning: {name}: {w}");
+                }
+            }
+        }
+        if args.common.verbose {
+            eprint!("{}", describe(&plan, &name, &target));
+        }
+        let text = match &input {
+            Input::Bvh(b) => bvh::write_string(&plan.apply_bvh(b)),
+            Input::Document(d) => {
+                let source = format!("{} (skel-aug --seed {} variant {i})", d.source, args.common.seed);
+                let motion = if plan.is_empty() { d.motion.clone() } else { None };
+                let doc = SkeletonDocument::build(&plan.skeleton, motion, &source, d.topology.dmax);
+                let mut json = if args.pretty { serde_json::to_string_pretty(&doc) } else { serde_json::to_string(&doc) }
+                    .context("serialising the skeleton document")?;
+                json.push('\n');
+                json
+            }
+        };
+        io::write_output(out.as_deref(), text.as_bytes()).with_context(|| format!("cannot write {target}"))?;
+    }
+    Ok(())
+}
+
+fn options(args: &Args) -> anyhow::Result<augment::Options> {
+    let remove = match (args.no_remove, args.remove_rate) {
+        (true, _) => None,
+        (false, None) => Some(RemoveAmount::Random),
+        (false, Some(r)) if r > 0.0 && r < 1.0 => Some(RemoveAmount::Rate(r)),
+        (false, Some(r)) => bail!("--remove-rate {r}: must be between 0 and 1, exclusive (use --no-remove to remove nothing)"),
+    };
+    Ok(augment::Options { remove, add: args.add, keep_feet: !args.allow_feet })
+}
+
+/// One output per variant: `None` = stdout.
+fn output_paths(output: Option<&Path>, count: usize) -> anyhow::Result<Vec<Option<PathBuf>>> {
+    match output {
+        Some(p) if p.as_os_str() != "-" => (0..count).map(|i| io::numbered_output(p, i, count).map(Some).map_err(anyhow::Error::msg)).collect(),
+        _ if count > 1 => bail!("{count} variants need a numbered output path such as -o 'out_{{i}}.bvh' ('{{i}}' becomes 0..{})", count - 1),
+        _ => Ok(vec![None]),
+    }
+}
+
+/// JSON documents start with '{' (after whitespace or a byte-order mark); BVH with HIERARCHY.
+fn looks_like_json(bytes: &[u8]) -> bool {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{')
+}
+
+/// Variant `i`'s generator: independent streams for every (seed, variant), and variant 0 of
+/// `-n K` is the same as a single run, whatever K.
+fn variant_rng(seed: u64, i: usize) -> SplitMix64 {
+    let a = SplitMix64::new(seed).next_u64();
+    let b = SplitMix64::new(!(i as u64)).next_u64();
+    SplitMix64::new(a ^ b)
+}
+
+/// Where a plan fell short of what was asked, in words.
+fn warnings(plan: &Plan, skeleton: &Skeleton, add: usize, keep_feet: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    let n = plan.joints_before;
+    if let Some(r) = &plan.removal {
+        if r.removed.len() < r.target {
+            let why = if keep_feet { "chains ending in end effectors stop at feet, branching joints and the root" } else { "chains stop at branching joints and the root" };
+            let mut w = if r.removable == 0 {
+                format!("none of the {n} joints can be removed ({why})")
+            } else {
+                format!(
+                    "only {} of {n} joints ({:.1}%) can be removed ({why}); removing all of them, fewer than asked",
+                    r.removable,
+                    100.0 * r.removable as f64 / n as f64,
+                )
+            };
+            if keep_feet && r.removable * 10 < n && !crate::skeleton::roles::feet(skeleton).0.is_empty() {
+                w.push_str("; --allow-feet lets removal take feet (for bodies that lie on the ground)");
+            }
+            out.push(w);
+        }
+    }
+    if plan.added.len() < add {
+        out.push(format!("no bone long enough to split: added {} of {add} joints", plan.added.len()));
+    }
+    out
+}
+
+/// What a plan changed, for -v.
+fn describe(plan: &Plan, input: &str, target: &str) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "skel-aug: {input} -> {target}: {} -> {} joints", plan.joints_before, plan.skeleton.len());
+    if let Some(r) = &plan.removal {
+        let pct = 100.0 * r.removed.len() as f64 / plan.joints_before as f64;
+        let list = if r.removed.is_empty() { "nothing".to_string() } else { r.removed.join(", ") };
+        let _ = writeln!(s, "    removed {} ({pct:.1}%, asked {}): {list}", r.removed.len(), r.target);
+        if !r.new_end_effectors.is_empty() {
+            let _ = writeln!(s, "    new end effectors: {}", r.new_end_effectors.join(", "));
+        }
+    }
+    for a in &plan.added {
+        let _ = writeln!(s, "    added {} between {} and {}", a.name, a.parent, a.child);
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_is_recognised_by_its_first_character() {
+        assert!(looks_like_json(b"  \n{\"format\": 1}"));
+        assert!(looks_like_json(b"\xEF\xBB\xBF{}"));
+        assert!(!looks_like_json(b"HIERARCHY\n"));
+        assert!(!looks_like_json(b""));
+    }
+
+    #[test]
+    fn variant_streams_differ_and_do_not_depend_on_the_count() {
+        let a: Vec<u64> = (0..4).map(|i| variant_rng(5, i).next_u64()).collect();
+        let unique: BTreeSet<u64> = a.iter().copied().collect();
+        assert_eq!(unique.len(), 4);
+        assert_ne!(variant_rng(5, 0).next_u64(), variant_rng(6, 0).next_u64());
+    }
+
+    #[test]
+    fn output_patterns() {
+        assert_eq!(output_paths(None, 1).unwrap(), vec![None]);
+        assert!(output_paths(None, 2).is_err());
+        assert!(output_paths(Some(Path::new("-")), 2).is_err());
+        assert!(output_paths(Some(Path::new("a.bvh")), 2).is_err());
+        let p = output_paths(Some(Path::new("a_{i}.bvh")), 2).unwrap();
+        assert_eq!(p, vec![Some(PathBuf::from("a_0.bvh")), Some(PathBuf::from("a_1.bvh"))]);
+    }
 }

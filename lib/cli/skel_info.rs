@@ -9,6 +9,13 @@ use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+const EXAMPLES: &str = "\
+EXAMPLES:
+    skel-info examples/data/biped.bvh --pretty
+    skel-info examples/data/spider.bvh --format text
+    cat examples/data/snake.bvh | skel-info - --dmax 3 -o snake.json
+    skel-info examples/data/*.bvh > zoo.jsonl";
+
 /// Print a BVH file's skeleton: graph, topology, names, sides, feet, rest pose.
 ///
 /// Reads one or more BVH files (or '-' for stdin) and prints, for each, the skeleton document
@@ -20,13 +27,6 @@ use std::path::PathBuf;
 /// Schema is docs/skeleton.schema.json.
 ///
 /// With --format text it prints a readable tree and a summary instead.
-const EXAMPLES: &str = "\
-EXAMPLES:
-    skel-info examples/data/biped.bvh --pretty
-    skel-info examples/data/spider.bvh --format text
-    cat examples/data/snake.bvh | skel-info - --dmax 3 -o snake.json
-    skel-info examples/data/*.bvh > zoo.jsonl";
-
 #[derive(clap::Parser, Debug)]
 #[command(name = "skel-info", version, after_long_help = EXAMPLES)]
 pub struct Args {
