@@ -23,12 +23,20 @@ _mo__encode() {
 
     case "${cmd}" in
         mo__encode)
-            opts="-o -q -v -h -V --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --repr --decode --skeleton --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
+                --repr)
+                    COMPREPLY=($(compgen -W "m2m" -- "${cur}"))
+                    return 0
+                    ;;
+                --skeleton)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --output)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0

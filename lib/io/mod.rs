@@ -2,6 +2,7 @@
 //! atomically (temp file in the same directory, then rename) so a crash or an error never
 //! leaves half a file behind.
 
+pub mod npy;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
