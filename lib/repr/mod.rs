@@ -5,6 +5,7 @@
 //! Encodings live in their own modules (`m2m`: Motion2Motion's local 6D rotations + root
 //! motion; `anytop`: AnyTop's 13-D per-joint features).
 
+pub mod anytop;
 pub mod m2m;
 /// A `[frames, joints, dims]` float32 tensor, row-major (dims fastest).
 #[derive(Clone, Debug, PartialEq)]
