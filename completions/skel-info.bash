@@ -23,7 +23,7 @@ _skel__info() {
 
     case "${cmd}" in
         skel__info)
-            opts="-o -q -v -h -V --format --dmax --pretty --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --format --dmax --pretty --rest-pose --no-anytop --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -34,6 +34,10 @@ _skel__info() {
                     return 0
                     ;;
                 --dmax)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --rest-pose)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -10,6 +10,7 @@
 use crate::bvh::Channel;
 use crate::bvh::Bvh;
 use crate::motion::Motion;
+use crate::repr::anytop::{AnyTopError, AnyTopOptions, AnyTopRig, AnyTopStats, RestSource};
 use crate::skeleton::names::{self, Side};
 use crate::skeleton::roles::{self, FootRule};
 use crate::skeleton::{topology, Joint, Skeleton, Stats};
@@ -33,6 +34,39 @@ pub struct SkeletonDocument {
     /// Present when the BVH had frames.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<MotionInfo>,
+    /// AnyTop's per-skeleton record (reference/anytop.md §1.7): what `mo-encode` needs to turn
+    /// motion into features and back on this skeleton.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anytop: Option<AnyTopSection>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct AnyTopSection {
+    /// Natural rest pose, scale, ground, facing rule and feet.
+    pub rig: AnyTopRig,
+    /// P_S: the 13 features of every joint in the natural rest pose, J x 13.
+    pub rest_row: Vec<Vec<f32>>,
+    /// Normalisation statistics (AnyTop's grouping) of the motion the document came from;
+    /// absent when it had fewer than two frames.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stats: Option<AnyTopStats>,
+}
+
+impl AnyTopSection {
+    /// Rig from `rest` (its frame 0 is the rest pose, frame 1 gives P_S its velocity), and
+    /// statistics over `clips` (those with at least two frames).
+    pub fn build(skeleton: &Skeleton, rest: &Motion, source: RestSource, clips: &[&Motion]) -> Result<AnyTopSection, AnyTopError> {
+        let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
+        let rig = AnyTopRig::new(skeleton, rest, &options)?;
+        let row = rig.rest_features(skeleton, rest)?;
+        let rest_row = (0..row.joints).map(|j| row.at(0, j).to_vec()).collect();
+        let mut features = Vec::new();
+        for clip in clips.iter().filter(|m| m.frames >= 2) {
+            features.push(rig.encode(skeleton, clip)?.features);
+        }
+        let stats = if features.is_empty() { None } else { Some(AnyTopStats::compute(features.iter())?) };
+        Ok(AnyTopSection { rig, rest_row, stats })
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -115,6 +149,8 @@ pub enum DocumentError {
     Joint { joint: usize, name: String, what: String },
     #[error("{0}")]
     Skeleton(#[from] crate::skeleton::SkeletonError),
+    #[error("its AnyTop record does not fit the skeleton: {0}")]
+    AnyTop(#[from] AnyTopError),
 }
 
 impl SkeletonDocument {
@@ -169,6 +205,7 @@ impl SkeletonDocument {
                 bone_length: Stats::of(&skeleton.bone_lengths()),
             },
             motion,
+            anytop: None,
         }
     }
 
@@ -178,7 +215,10 @@ impl SkeletonDocument {
         if doc.format != FORMAT || doc.version != FORMAT_VERSION {
             return Err(DocumentError::Version { format: doc.format, version: doc.version });
         }
-        doc.skeleton()?;
+        let skeleton = doc.skeleton()?;
+        if let Some(section) = &doc.anytop {
+            section.rig.check(&skeleton)?;
+        }
         Ok(doc)
     }
 

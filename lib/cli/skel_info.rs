@@ -1,7 +1,9 @@
 //! `skel-info`: BVH -> skeleton document (JSON) or a readable tree.
 
 use crate::cli::CommonOpts;
-use crate::document::{MotionInfo, SkeletonDocument};
+use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
+use crate::motion::Motion;
+use crate::repr::anytop::RestSource;
 use crate::skeleton::names::Side;
 use crate::skeleton::{topology, Skeleton};
 use crate::{bvh, io};
@@ -42,6 +44,13 @@ pub struct Args {
     /// Indent the JSON for humans.
     #[arg(long)]
     pub pretty: bool,
+    /// Take AnyTop's natural rest pose from frame 0 of this BVH (same skeleton) instead of
+    /// frame 0 of each input.
+    #[arg(long, value_name = "BVH")]
+    pub rest_pose: Option<PathBuf>,
+    /// Leave out the AnyTop record (rig, rest-pose features P_S, normalisation statistics).
+    #[arg(long)]
+    pub no_anytop: bool,
     #[command(flatten)]
     pub common: CommonOpts,
 }
@@ -57,13 +66,26 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.inputs.iter().filter(|p| p.as_os_str() == "-").count() > 1 {
         anyhow::bail!("stdin ('-') can be read only once");
     }
+    let rest_pose = match &args.rest_pose {
+        Some(path) => {
+            let name = io::display_name(path);
+            let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+            let parsed = bvh::parse_bytes(&bytes, &name)?;
+            let skeleton = Skeleton::from_bvh(&parsed);
+            Some((name, skeleton.clone(), Motion::from_bvh_frames(&parsed, &skeleton, 0..2)))
+        }
+        None => None,
+    };
     let mut out = String::new();
     for path in &args.inputs {
         let name = io::display_name(path);
         let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
         let parsed = bvh::parse_bytes(&bytes, &name)?;
         let skeleton = Skeleton::from_bvh(&parsed);
-        let doc = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, args.dmax as usize);
+        let mut doc = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, args.dmax as usize);
+        if !args.no_anytop {
+            doc.anytop = anytop_section(&parsed, &skeleton, &name, rest_pose.as_ref(), args.common.quiet)?;
+        }
         match args.format {
             Format::Json => {
                 let json = if args.pretty { serde_json::to_string_pretty(&doc) } else { serde_json::to_string(&doc) };
@@ -75,6 +97,46 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     io::write_output(args.common.output.as_deref(), out.as_bytes())
         .with_context(|| format!("cannot write {}", args.common.output.as_ref().map_or("stdout".into(), |p| p.display().to_string())))
+}
+
+/// AnyTop's record for one input: the rest pose is frame 0 of `--rest-pose` when given, else
+/// frame 0 of the input itself (AnyTop's choice when there is no T-pose file), else, for a
+/// file without frames, the OFFSET pose.
+fn anytop_section(
+    parsed: &bvh::Bvh,
+    skeleton: &Skeleton,
+    name: &str,
+    rest_pose: Option<&(String, Skeleton, Motion)>,
+    quiet: bool,
+) -> anyhow::Result<Option<AnyTopSection>> {
+    let motion = Motion::from_bvh(parsed, skeleton);
+    let (rest, source) = match rest_pose {
+        Some((file, rest_skeleton, rest)) => {
+            let same = rest_skeleton.joints.len() == skeleton.joints.len()
+                && rest_skeleton.joints.iter().zip(&skeleton.joints).all(|(a, b)| a.name == b.name && a.parent == b.parent);
+            if !same {
+                anyhow::bail!("--rest-pose {file} has a different skeleton than {name}");
+            }
+            (rest.clone(), RestSource::Explicit { file: file.clone() })
+        }
+        None if parsed.frames > 0 => {
+            let file = name.to_string();
+            let source = if file.to_lowercase().contains("tpos") { RestSource::TPose { file } } else { RestSource::FirstClip { file } };
+            (Motion::from_bvh_frames(parsed, skeleton, 0..2), source)
+        }
+        None => (Motion::rest(skeleton), RestSource::Offsets),
+    };
+    // A skeleton AnyTop cannot describe (a single joint, bones of zero length) is still a
+    // skeleton: describe it without the record and say why.
+    match AnyTopSection::build(skeleton, &rest, source, &[&motion]) {
+        Ok(section) => Ok(Some(section)),
+        Err(e) => {
+            if !quiet {
+                eprintln!("skel-info: {name}: no AnyTop record: {e}");
+            }
+            Ok(None)
+        }
+    }
 }
 
 /// A readable tree and summary of one skeleton document.
@@ -149,6 +211,22 @@ pub fn text_report(doc: &SkeletonDocument) -> String {
         let _ = write!(s, ", bone length {:.4}..{:.4} (mean {:.4})", b.min, b.max, b.mean);
     }
     s.push('\n');
+    if let Some(a) = &doc.anytop {
+        let rig = &a.rig;
+        let facing = match &rig.facing {
+            crate::repr::anytop::Facing::FaceJoints(f) => format!("face joints {}", names(f)),
+            crate::repr::anytop::Facing::BodyAxis { front, back } => {
+                format!("body axis {} -> {}", doc.joints[*back].name, doc.joints[*front].name)
+            }
+        };
+        let _ = writeln!(
+            s,
+            "  anytop: scale {:.5}, {facing}, {} contact joints, statistics {}",
+            rig.scale_factor,
+            rig.feet.len(),
+            if a.stats.is_some() { "yes" } else { "no" }
+        );
+    }
     match &doc.motion {
         Some(m) => {
             let _ = writeln!(s, "  motion: {} frames at {:.3} fps ({:.2} s)", m.frames, m.fps, m.duration_s);
