@@ -17,6 +17,7 @@
 use menagerie::bvh;
 use menagerie::io::npy;
 use menagerie::motion::Motion;
+use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig, Encoded, IkOptions};
 use menagerie::repr::{m2m, Features};
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;
@@ -104,6 +105,44 @@ fn main() {
             human(fps(&bvh_to_npy_par)),
             human(fps(&npy_to_bvh)),
         );
+    }
+
+    // AnyTop: the rig is built once per clip from its own frame 0 (as skel-info does) and is
+    // not timed; encode, decode from rotations and decode from positions (IK) are.
+    println!();
+    println!("AnyTop representation (13-D per joint); {RUNS} runs each, one thread, frames/s from the median");
+    println!();
+    println!("| input | files | frames | encode f/s | decode (rotations) f/s | decode (IK) f/s |");
+    println!("|---|---:|---:|---:|---:|---:|");
+    for (name, files) in &sets {
+        let clips: Vec<Clip> = files.iter().map(|p| load(p)).filter(|c| c.motion.frames >= 2).collect();
+        let rigged: Vec<(&Clip, AnyTopRig, Encoded)> = clips
+            .iter()
+            .filter_map(|c| {
+                let rest = Motion { frames: 1, rotations: c.motion.rotations[..c.motion.joints].to_vec(), translations: c.motion.translations[..c.motion.joints].to_vec(), ..c.motion.clone() };
+                let rig = AnyTopRig::new(&c.skeleton, &rest, &AnyTopOptions::default()).ok()?;
+                let encoded = rig.encode(&c.skeleton, &c.motion).ok()?;
+                Some((c, rig, encoded))
+            })
+            .collect();
+        let frames: usize = rigged.iter().map(|(_, _, e)| e.features.frames).sum();
+        let encode = time_runs(|| {
+            for (c, rig, _) in &rigged {
+                black_box(rig.encode(&c.skeleton, black_box(&c.motion)).unwrap());
+            }
+        });
+        let decode = time_runs(|| {
+            for (c, rig, e) in &rigged {
+                black_box(rig.decode(&c.skeleton, black_box(&e.features), &e.placement).unwrap());
+            }
+        });
+        let ik = time_runs(|| {
+            for (c, rig, e) in &rigged {
+                black_box(rig.decode_ik(&c.skeleton, black_box(&e.features), &e.placement, &IkOptions::default()).unwrap());
+            }
+        });
+        let fps = |t: &[Duration]| frames as f64 / median(t).as_secs_f64();
+        println!("| {name} | {} | {frames} | {} | {} | {} |", rigged.len(), human(fps(&encode)), human(fps(&decode)), human(fps(&ik)));
     }
 }
 
