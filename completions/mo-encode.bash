@@ -23,18 +23,50 @@ _mo__encode() {
 
     case "${cmd}" in
         mo__encode)
-            opts="-o -q -v -h -V --repr --decode --skeleton --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --repr --decode --skeleton --rest-pose --face-joints --body-axis --feet --normalise --stats --emit-skeleton --placement --from --normalised --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --repr)
-                    COMPREPLY=($(compgen -W "m2m" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "anytop m2m" -- "${cur}"))
                     return 0
                     ;;
                 --skeleton)
                     COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --rest-pose)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --face-joints)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --body-axis)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --feet)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --stats)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --emit-skeleton)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --placement)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --from)
+                    COMPREPLY=($(compgen -W "rotations positions" -- "${cur}"))
                     return 0
                     ;;
                 --output)

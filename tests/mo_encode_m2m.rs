@@ -67,9 +67,9 @@ fn round_trip(path: &Path, dir: &Path, skeleton_arg: Option<&Path>) -> RoundTrip
     let stem = format!("{serial}-{}", path.file_stem().unwrap().to_string_lossy().replace(' ', "_"));
     let npy_path = dir.join(format!("{stem}.npy"));
     let back_path = dir.join(format!("{stem}.back.bvh"));
-    ok(&common::run("mo-encode", &[s(path), "-o", s(&npy_path), "-q"], None), &format!("encode {}", path.display()));
+    ok(&common::run("mo-encode", &["--repr", "m2m", s(path), "-o", s(&npy_path), "-q"], None), &format!("encode {}", path.display()));
     let skeleton_arg = skeleton_arg.unwrap_or(path);
-    let out = common::run("mo-encode", &["--decode", "--skeleton", s(skeleton_arg), s(&npy_path), "-o", s(&back_path)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(skeleton_arg), s(&npy_path), "-o", s(&back_path)], None);
     ok(&out, &format!("decode {}", path.display()));
 
     let (skeleton, original) = load(path);
@@ -105,10 +105,10 @@ fn examples_round_trip_through_the_binary() {
     ok(&doc, "skel-info");
     let doc_path = dir.join("spider.json");
     std::fs::write(&doc_path, &doc.stdout).unwrap();
-    let enc = common::run("mo-encode", &[s(spider)], None);
+    let enc = common::run("mo-encode", &["--repr", "m2m", s(spider)], None);
     ok(&enc, "encode to stdout");
-    let from_bvh = common::run("mo-encode", &["--decode", "--skeleton", s(spider)], Some(&enc.stdout));
-    let from_doc = common::run("mo-encode", &["--decode", "--skeleton", s(&doc_path), "-"], Some(&enc.stdout));
+    let from_bvh = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(spider)], Some(&enc.stdout));
+    let from_doc = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&doc_path), "-"], Some(&enc.stdout));
     ok(&from_bvh, "decode on BVH");
     ok(&from_doc, "decode on document");
     assert_eq!(from_bvh.stdout, from_doc.stdout);
@@ -176,8 +176,8 @@ fn numpy_loads_the_encoded_tensor() {
     let biped = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/biped.bvh");
     let one = dir.join("one.npy");
     let two = dir.join("two.npy");
-    ok(&common::run("mo-encode", &[s(&biped), "-o", s(&one)], None), "encode");
-    ok(&common::run("mo-encode", &[s(&biped), s(&biped), "-o", s(&two)], None), "encode batch");
+    ok(&common::run("mo-encode", &["--repr", "m2m", s(&biped), "-o", s(&one)], None), "encode");
+    ok(&common::run("mo-encode", &["--repr", "m2m", s(&biped), s(&biped), "-o", s(&two)], None), "encode batch");
     let (_, motion) = load(&biped);
     let f = m2m::encode(&motion);
     let script = format!(
@@ -215,7 +215,7 @@ fn batches_stack_equal_shapes_and_name_the_odd_file() {
     let dir = tempdir("batch");
     let ex = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data");
     let (bird, crab) = (ex.join("bird.bvh"), ex.join("crab.bvh"));
-    let out = common::run("mo-encode", &[s(&bird), s(&bird), s(&bird)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", s(&bird), s(&bird), s(&bird)], None);
     ok(&out, "batch");
     let a = npy::from_bytes(&out.stdout, "batch").unwrap();
     let (_, motion) = load(&bird);
@@ -229,15 +229,15 @@ fn batches_stack_equal_shapes_and_name_the_odd_file() {
     let batch_npy = dir.join("b.npy");
     std::fs::write(&batch_npy, &out.stdout).unwrap();
     let pattern = dir.join("bird_{i}.bvh");
-    ok(&common::run("mo-encode", &["--decode", "--skeleton", s(&bird), s(&batch_npy), "-o", s(&pattern)], None), "decode batch");
-    let single = common::run("mo-encode", &["--decode", "--skeleton", s(&bird)], Some(&npy::to_bytes(&one.shape(), &one.data).unwrap()));
+    ok(&common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bird), s(&batch_npy), "-o", s(&pattern)], None), "decode batch");
+    let single = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bird)], Some(&npy::to_bytes(&one.shape(), &one.data).unwrap()));
     ok(&single, "decode single");
     for i in 0..3 {
         assert_eq!(std::fs::read(dir.join(format!("bird_{i}.bvh"))).unwrap(), single.stdout, "sample {i}");
     }
 
     let target = dir.join("mixed.npy");
-    let out = common::run("mo-encode", &[s(&bird), s(&bird), s(&crab), "-o", s(&target)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", s(&bird), s(&bird), s(&crab), "-o", s(&target)], None);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
@@ -253,7 +253,8 @@ fn output_is_byte_identical_for_any_thread_count() {
     let spider = files.iter().find(|p| p.ends_with("spider.bvh")).unwrap();
     let batch: Vec<&str> = vec![s(spider); 6];
     let run = |args: &[&str], threads: &str| {
-        let mut a = args.to_vec();
+        let mut a = vec!["--repr", "m2m"];
+        a.extend_from_slice(args);
         a.extend(["--threads", threads]);
         let out = common::run("mo-encode", &a, None);
         ok(&out, "encode");
@@ -269,7 +270,7 @@ fn output_is_byte_identical_for_any_thread_count() {
     std::fs::write(&npy_path, &one).unwrap();
     for threads in ["1", "2"] {
         let pattern = dir.join(format!("t{threads}_{{i}}.bvh"));
-        ok(&common::run("mo-encode", &["--decode", "--skeleton", s(spider), s(&npy_path), "-o", s(&pattern), "--threads", threads], None), "decode");
+        ok(&common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(spider), s(&npy_path), "-o", s(&pattern), "--threads", threads], None), "decode");
     }
     for i in 0..6 {
         let a = std::fs::read(dir.join(format!("t1_{i}.bvh"))).unwrap();
@@ -302,7 +303,7 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
     let dir = tempdir("bad");
     let bvh_path = dir.join("tiny.bvh");
     std::fs::write(&bvh_path, TINY).unwrap();
-    let good = common::run("mo-encode", &[s(&bvh_path)], None);
+    let good = common::run("mo-encode", &["--repr", "m2m", s(&bvh_path)], None);
     ok(&good, "encode tiny");
     let f = features_of(npy::from_bytes(&good.stdout, "tiny").unwrap());
     assert_eq!(f.shape(), [2, 2, 9]);
@@ -334,44 +335,44 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
     ];
     for (what, input, expect) in &cases {
         let target = dir.join(format!("out-{}.bvh", what.replace(' ', "_")));
-        let out = common::run("mo-encode", &["--decode", "--skeleton", s(&bvh_path), s(input), "-o", s(&target)], None);
+        let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bvh_path), s(input), "-o", s(&target)], None);
         check_failure(what, &out, expect);
         assert!(!target.exists(), "{what}: output written despite the error");
     }
     // f8 input is accepted and converted.
     let f8 = write("f8.npy", &raw_npy("<f8", "(2, 2, 9)", &f64_payload, false));
-    let out = common::run("mo-encode", &["--decode", "--skeleton", s(&bvh_path), s(&f8)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bvh_path), s(&f8)], None);
     ok(&out, "f8 decode");
 
     // A batch needs a numbered output.
     let batch = write("batch.npy", &npy_of(&[2, 2, 2, 9], &[f.data.clone(), f.data.clone()].concat()));
-    let out = common::run("mo-encode", &["--decode", "--skeleton", s(&bvh_path), s(&batch)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bvh_path), s(&batch)], None);
     check_failure("batch to stdout", &out, "give -o a pattern");
     let target = dir.join("plain.bvh");
-    let out = common::run("mo-encode", &["--decode", "--skeleton", s(&bvh_path), s(&batch), "-o", s(&target)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bvh_path), s(&batch), "-o", s(&target)], None);
     check_failure("batch without {i}", &out, "numbered output path");
     assert!(!target.exists());
 
     // Skeletons that are neither documents nor BVH; documents that are broken.
     let junk = write("junk.txt", b"hello");
-    let out = common::run("mo-encode", &["--decode", "--skeleton", s(&junk), s(&batch)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&junk), s(&batch)], None);
     check_failure("junk skeleton", &out, "not a skeleton");
     let broken = write("broken.json", b"{\"format\": \"menagerie.skeleton\"");
-    let out = common::run("mo-encode", &["--decode", "--skeleton", s(&broken), s(&batch)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&broken), s(&batch)], None);
     check_failure("broken document", &out, "not a skeleton document");
 
     // Encoding errors: a broken BVH among good ones, a missing file; nothing written.
     let broken_bvh = write("broken.bvh", &TINY.as_bytes()[..TINY.len() - 12]);
     let target = dir.join("enc.npy");
-    let out = common::run("mo-encode", &[s(&bvh_path), s(&broken_bvh), "-o", s(&target)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", s(&bvh_path), s(&broken_bvh), "-o", s(&target)], None);
     check_failure("broken BVH", &out, "broken.bvh:");
     assert!(!target.exists());
-    let out = common::run("mo-encode", &["/nonexistent/x.bvh", "-o", s(&target)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "/nonexistent/x.bvh", "-o", s(&target)], None);
     check_failure("missing file", &out, "/nonexistent/x.bvh");
-    let out = common::run("mo-encode", &["-", "-"], Some(TINY.as_bytes()));
+    let out = common::run("mo-encode", &["--repr", "m2m", "-", "-"], Some(TINY.as_bytes()));
     check_failure("stdin twice", &out, "only once");
     // Usage errors (clap) also exit 2.
-    let out = common::run("mo-encode", &["--decode", s(&batch)], None);
+    let out = common::run("mo-encode", &["--repr", "m2m", "--decode", s(&batch)], None);
     assert_eq!(out.status.code(), Some(2));
     let out = common::run("mo-encode", &["--repr", "nope", s(&bvh_path)], None);
     assert_eq!(out.status.code(), Some(2));
@@ -399,12 +400,12 @@ fn stdin_in_and_out_and_closed_pipes() {
     let ex = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data");
     let fish = ex.join("fish.bvh");
     let text = std::fs::read(&fish).unwrap();
-    let from_file = common::run("mo-encode", &[s(&fish)], None);
-    let from_stdin = common::run("mo-encode", &["-"], Some(&text));
+    let from_file = common::run("mo-encode", &["--repr", "m2m", s(&fish)], None);
+    let from_stdin = common::run("mo-encode", &["--repr", "m2m", "-"], Some(&text));
     ok(&from_stdin, "stdin encode");
     assert_eq!(from_file.stdout, from_stdin.stdout);
     // Decode reads stdin when no input is given.
-    let decoded = common::run("mo-encode", &["--decode", "--skeleton", s(&fish)], Some(&from_stdin.stdout));
+    let decoded = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&fish)], Some(&from_stdin.stdout));
     ok(&decoded, "stdin decode");
     let (skeleton, original) = load(&fish);
     let back = Motion::from_bvh(&bvh::parse_bytes(&decoded.stdout, "decoded").unwrap(), &skeleton);
@@ -413,7 +414,7 @@ fn stdin_in_and_out_and_closed_pipes() {
     // `| head -c 10`: a closed pipe is success, and quiet.
     let centipede = ex.join("centipede.bvh");
     let many: Vec<&str> = vec![s(&centipede); 40];
-    let mut child = common::bin("mo-encode").args(&many).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut child = common::bin("mo-encode").args(["--repr", "m2m"]).args(&many).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
     let mut stdout = child.stdout.take().unwrap();
     let mut first = [0u8; 10];
     std::io::Read::read_exact(&mut stdout, &mut first).unwrap();

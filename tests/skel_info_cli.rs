@@ -118,7 +118,7 @@ fn closed_stdout_pipe_is_success() {
     let dir = tempdir("pipe");
     let a = dir.join("a.bvh");
     std::fs::write(&a, TINY).unwrap();
-    let args: Vec<String> = std::iter::repeat(a.to_str().unwrap().to_string()).take(400).collect();
+    let args: Vec<String> = std::iter::repeat_n(a.to_str().unwrap().to_string(), 400).collect();
     let mut child = common::bin("skel-info").args(&args).arg("--pretty").stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
     let mut stdout = child.stdout.take().unwrap();
     let mut first = [0u8; 10];
