@@ -14,6 +14,7 @@ complete -c mo-encode -s o -l output -d 'Write output here instead of stdout (\'
 complete -c mo-encode -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-encode -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
 complete -c mo-encode -l decode -d 'Decode an NPY of features back to BVH on --skeleton'
+complete -c mo-encode -l require-contacts -d 'anytop: fail when the skeleton has no foot joints, instead of writing all-zero contact features with a warning (for training data of walkers, where a missed foot is a bug)'
 complete -c mo-encode -l normalise -d 'anytop: write normalised features, (x - mean) / (std + 1e-6)'
 complete -c mo-encode -l normalised -d 'anytop decoding: the NPY holds normalised features; undo it with --skeleton\'s statistics'
 complete -c mo-encode -s q -l quiet -d 'Print nothing on stderr but errors'

@@ -638,3 +638,23 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
     assert!(leftovers.is_empty(), "temp files left behind: {leftovers:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn require_contacts_fails_only_without_feet() {
+    let dir = tempdir("contacts");
+    let out = dir.join("fish.npy");
+    let fish = run(&[s(&example("fish.bvh")), "--require-contacts", "-o", s(&out)]);
+    assert_eq!(fish.status.code(), Some(2), "a fish has no feet");
+    let err = String::from_utf8_lossy(&fish.stderr);
+    assert!(err.contains("no foot joints") && err.trim_end().lines().count() == 1, "{err}");
+    assert!(!out.exists(), "no partial file");
+    // Without the flag the fish encodes, with a warning, and every contact is 0.
+    let plain = run(&[s(&example("fish.bvh")), "-o", s(&out)]);
+    ok(&plain, "fish without --require-contacts");
+    assert!(String::from_utf8_lossy(&plain.stderr).contains("warning"));
+    assert!(read_features(&out).data.chunks(13).all(|t| t[12] == 0.0));
+    // A walker has feet, so the flag changes nothing.
+    let walker = run(&[s(&example("quadruped.bvh")), "--require-contacts", "-o", s(&out)]);
+    ok(&walker, "quadruped with --require-contacts");
+    assert!(read_features(&out).data.chunks(13).any(|t| t[12] == 1.0));
+}

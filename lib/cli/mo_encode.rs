@@ -135,6 +135,10 @@ pub struct Args {
     /// anytop: the joints that get foot-contact labels (joint names) instead of the automatic choice.
     #[arg(long, value_name = "NAME,...", value_delimiter = ',', conflicts_with = "decode")]
     pub feet: Option<Vec<String>>,
+    /// anytop: fail when the skeleton has no foot joints, instead of writing all-zero contact
+    /// features with a warning (for training data of walkers, where a missed foot is a bug).
+    #[arg(long, conflicts_with = "decode")]
+    pub require_contacts: bool,
     /// anytop: write normalised features, (x - mean) / (std + 1e-6).
     ///
     /// With the statistics of --skeleton's AnyTop record when it has them, else of the given
@@ -227,6 +231,7 @@ fn refuse_anytop_flags(args: &Args) -> anyhow::Result<()> {
         (args.face_joints.is_some(), "--face-joints"),
         (args.body_axis.is_some(), "--body-axis"),
         (args.feet.is_some(), "--feet"),
+        (args.require_contacts, "--require-contacts"),
         (args.normalise, "--normalise"),
         (args.stats.is_some(), "--stats"),
         (args.emit_skeleton.is_some(), "--emit-skeleton"),
@@ -473,10 +478,15 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
         }
     };
     let rig = &section.rig;
-    if rig.feet.is_empty() && !args.common.quiet {
+    if rig.feet.is_empty() {
         // Contacts are part of every AnyTop token; without feet they are all zero, which is
         // right for a fish but surprising for a walker whose feet the names did not reveal.
-        eprintln!("mo-encode: warning: {}: no foot joints found, so every contact feature is 0 (name them with --feet)", first.name);
+        if args.require_contacts {
+            bail!("{}: no foot joints found for contact features (name them with --feet)", first.name);
+        }
+        if !args.common.quiet {
+            eprintln!("mo-encode: warning: {}: no foot joints found, so every contact feature is 0 (name them with --feet)", first.name);
+        }
     }
     if args.common.verbose {
         eprintln!("mo-encode: rig: {}", describe_rig(rig, &first.skeleton));
