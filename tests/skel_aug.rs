@@ -12,6 +12,8 @@
 //!   same skeleton as the BVH path; bad input exits 2 with one line and no file.
 mod common;
 
+use common::topology::{reference_distances, reference_relations};
+
 use glam::DVec3;
 use menagerie::augment::{self, Options, RemoveAmount};
 use menagerie::bvh::{self, Bvh};
@@ -31,57 +33,6 @@ const SEEDS: u64 = 3;
 // ---------------------------------------------------------------------------------------------
 // Brute-force topology (AnyTop §2.4), independent of lib/skeleton/topology.rs.
 
-fn ancestors(parents: &[Option<usize>], j: usize) -> Vec<usize> {
-    let mut out = vec![j];
-    let mut at = j;
-    while let Some(p) = parents[at] {
-        out.push(p);
-        at = p;
-    }
-    out
-}
-
-fn reference_distances(parents: &[Option<usize>], dmax: usize) -> Vec<Vec<u8>> {
-    let n = parents.len();
-    let anc: Vec<Vec<usize>> = (0..n).map(|j| ancestors(parents, j)).collect();
-    let mut d = vec![vec![0u8; n]; n];
-    for i in 0..n {
-        for j in 0..n {
-            let hops = anc[i]
-                .iter()
-                .enumerate()
-                .find_map(|(up_i, a)| anc[j].iter().position(|b| b == a).map(|up_j| up_i + up_j))
-                .unwrap_or(usize::MAX);
-            d[i][j] = hops.min(dmax) as u8;
-        }
-    }
-    d
-}
-
-fn reference_relations(parents: &[Option<usize>]) -> Vec<Vec<u8>> {
-    let n = parents.len();
-    let mut has_child = vec![false; n];
-    for p in parents.iter().flatten() {
-        has_child[*p] = true;
-    }
-    let mut r = vec![vec![0u8; n]; n];
-    for i in 0..n {
-        for j in 0..n {
-            r[i][j] = if i == j {
-                if has_child[i] { 0 } else { 5 }
-            } else if parents[j] == Some(i) {
-                2
-            } else if parents[i] == Some(j) {
-                1
-            } else if parents[j] == parents[i] {
-                3
-            } else {
-                4
-            };
-        }
-    }
-    r
-}
 
 fn check_topology(name: &str, skeleton: &Skeleton) {
     skeleton.validate().unwrap_or_else(|e| panic!("{name}: {e}"));

@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+pub mod topology;
+
 /// `../shared/data` next to the checkout, or `None` (with a printed note) when it is absent,
 /// so a fresh clone without the licensed corpus still passes.
 pub fn shared_data(test: &str) -> Option<PathBuf> {
