@@ -16,15 +16,8 @@ const MAX_CHANNELS_PER_JOINT: usize = 6;
 
 /// Read and parse a BVH file. `-` reads standard input.
 pub fn read_path(path: &Path) -> Result<Bvh, BvhError> {
-    let name = path.display().to_string();
-    let data = if name == "-" {
-        let mut buf = Vec::new();
-        std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut buf)
-            .map_err(|source| BvhError::Io { file: "<stdin>".into(), source })?;
-        return parse_bytes(&buf, "<stdin>");
-    } else {
-        std::fs::read(path).map_err(|source| BvhError::Io { file: name.clone(), source })?
-    };
+    let name = crate::io::display_name(path);
+    let data = crate::io::read_input(path).map_err(|source| BvhError::Io { file: name.clone(), source })?;
     parse_bytes(&data, &name)
 }
 
