@@ -54,8 +54,9 @@ pub enum Side {
     Centre,
 }
 
-/// Split a raw name into words (rules 1-2).
-fn split_words(raw: &str) -> Vec<String> {
+/// Split a raw name into words (rules 1-2): no namespace, no Truebones suffix, split at
+/// separators, case changes and digit runs.
+pub fn split_words(raw: &str) -> Vec<String> {
     let mut s = raw;
     if let Some(i) = s.rfind(':') {
         if i + 1 < s.len() {

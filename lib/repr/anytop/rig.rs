@@ -415,45 +415,14 @@ fn mean_offset_length(skeleton: &Skeleton) -> Result<f64, AnyTopError> {
 /// The key that left and right partners share: the raw name without namespace, Truebones
 /// suffix and side words, lower case.
 fn mirror_key(raw: &str) -> String {
-    let mut s = raw.rsplit(':').next().unwrap_or(raw);
-    if let Some(i) = s.rfind("__") {
-        let tail = &s[i + 2..];
-        if i > 0 && tail.len() == 3 && tail.chars().all(|c| c.is_ascii_alphanumeric()) {
-            s = &s[..i];
-        }
-    }
-    let chars: Vec<char> = s.chars().collect();
-    let mut words: Vec<String> = Vec::new();
-    let mut cur = String::new();
-    for (k, &c) in chars.iter().enumerate() {
-        if !c.is_alphanumeric() {
-            if !cur.is_empty() {
-                words.push(std::mem::take(&mut cur));
-            }
-            continue;
-        }
-        if let Some(prev) = cur.chars().last() {
-            let next = chars.get(k + 1).copied();
-            let boundary = (prev.is_lowercase() && c.is_uppercase())
-                || (prev.is_alphabetic() && c.is_ascii_digit())
-                || (prev.is_ascii_digit() && c.is_alphabetic())
-                || (prev.is_uppercase() && c.is_uppercase() && next.is_some_and(|x| x.is_lowercase()));
-            if boundary {
-                words.push(std::mem::take(&mut cur));
-            }
-        }
-        cur.push(c);
-    }
-    if !cur.is_empty() {
-        words.push(cur);
-    }
-    words
+    crate::skeleton::names::split_words(raw)
         .into_iter()
         .map(|w| w.to_lowercase())
         .filter(|w| !matches!(w.as_str(), "l" | "r" | "left" | "right"))
         .collect::<Vec<_>>()
         .join("_")
 }
+
 
 /// The automatic facing rule (module doc).
 pub(super) fn automatic_facing(skeleton: &Skeleton, p0: &[DVec3], feet: &[usize]) -> Facing {
