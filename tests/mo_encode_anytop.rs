@@ -15,6 +15,8 @@
 //! The worst errors are printed (run with `--nocapture`).
 mod common;
 
+use common::{tempdir, s, ok, load, check_failure};
+
 use menagerie::bvh;
 use menagerie::document::SkeletonDocument;
 use menagerie::io::npy;
@@ -26,34 +28,12 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-fn tempdir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("menagerie-mo-encode-anytop-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data").join(name)
 }
 
 fn run(args: &[&str]) -> Output {
     common::run("mo-encode", args, None)
-}
-
-fn ok(out: &Output, what: &str) {
-    assert!(out.status.success(), "{what}: exit {:?}: {}", out.status.code(), String::from_utf8_lossy(&out.stderr));
-}
-
-fn load(path: &Path) -> (Skeleton, Motion) {
-    let parsed = bvh::read_path(path).unwrap_or_else(|e| panic!("{e}"));
-    let skeleton = Skeleton::from_bvh(&parsed);
-    let motion = Motion::from_bvh(&parsed, &skeleton);
-    (skeleton, motion)
 }
 
 fn read_npy(path: &Path) -> npy::NpyArray {
@@ -269,7 +249,7 @@ fn corpus_round_trips_through_the_binary() {
     for path in &single {
         let target = dir.join("single.npy");
         let out = run(&[s(path), "-o", s(&target)]);
-        check_failure(&label(path), &out, "AnyTop features need at least two frames");
+        check_failure("mo-encode", &label(path), &out, "AnyTop features need at least two frames");
         assert!(!target.exists());
         eprintln!("  {}: one frame, refused", label(path));
     }
@@ -405,11 +385,11 @@ fn batches_keep_each_clips_placement() {
     let short = at("short.bvh");
     edited_copy(&biped, &short, 0.0, 0.0, Some(clip.frames - 5));
     let out = run(&[s(&biped), s(&short), "-o", s(&at("no.npy"))]);
-    check_failure("different lengths", &out, "cannot stack");
+    check_failure("mo-encode", "different lengths", &out, "cannot stack");
     assert!(String::from_utf8_lossy(&out.stderr).contains("short.bvh"));
     std::fs::write(at("one.json"), serde_json::to_string(&placements[..1]).unwrap()).unwrap();
     let out = run(&["--decode", "--skeleton", s(&at("s.json")), "--placement", s(&at("one.json")), s(&at("b.npy")), "-o", s(&at("x_{i}.bvh"))]);
-    check_failure("placement count", &out, "holds 1 placement(s) but");
+    check_failure("mo-encode", "placement count", &out, "holds 1 placement(s) but");
     assert!(!at("x_0.bvh").exists() && !at("no.npy").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -539,14 +519,6 @@ fn raw_npy(descr: &str, shape: &str, payload: &[u8]) -> Vec<u8> {
     out
 }
 
-fn check_failure(what: &str, out: &Output, expect: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{what}: {err}");
-    assert!(err.starts_with("mo-encode: ") && err.trim_end().lines().count() == 1, "{what}: not one line: {err}");
-    assert!(err.contains(expect), "{what}: expected '{expect}' in: {err}");
-    assert!(out.stdout.is_empty(), "{what}: printed on stdout");
-}
-
 #[test]
 fn bad_input_exits_2_with_one_line_and_no_file() {
     let dir = tempdir("bad");
@@ -593,7 +565,7 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
         let target = at("out.bvh");
         let skeleton_doc = if what.contains("--normalised") { at("bare.json") } else { doc.clone() };
         let out = run(&[&["--decode", "--skeleton", s(&skeleton_doc)], &extra[..], &[s(input), "-o", s(&target)]].concat());
-        check_failure(what, &out, expect);
+        check_failure("mo-encode", what, &out, expect);
         assert!(!target.exists(), "{what}: output written despite the error");
     }
 
@@ -620,12 +592,12 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
     let output_flags = ["-o", s(&outputs[0]), "--stats", s(&outputs[1]), "--emit-skeleton", s(&outputs[2]), "--placement", s(&outputs[3])];
     for (what, args, expect) in &encoding {
         let out = run(&[&args[..], &output_flags[..]].concat());
-        check_failure(what, &out, expect);
+        check_failure("mo-encode", what, &out, expect);
         assert!(outputs.iter().all(|p| !p.exists()), "{what}: output written despite the error");
     }
     // A later output that cannot be written takes the earlier ones back.
     let out = run(&[s(&biped), "-o", s(&outputs[0]), "--stats", "/nonexistent/dir/stats.json"]);
-    check_failure("unwritable --stats", &out, "cannot write /nonexistent/dir/stats.json");
+    check_failure("mo-encode", "unwritable --stats", &out, "cannot write /nonexistent/dir/stats.json");
     assert!(!outputs[0].exists(), "the NPY stayed behind a failed --stats");
     // One clip, one skeleton: the good encode above still round trips (sanity of the fixtures).
     assert_eq!(f.shape(), [clip.frames - 1, skeleton.len(), FEATURE_DIMS]);

@@ -5,35 +5,14 @@
 //! one line and leaves no file behind.
 mod common;
 
+use common::{tempdir, s, ok, load, check_failure};
+
 use menagerie::bvh;
 use menagerie::io::npy;
 use menagerie::motion::Motion;
 use menagerie::repr::{m2m, Features};
 use menagerie::skeleton::Skeleton;
 use std::path::{Path, PathBuf};
-use std::process::Output;
-
-fn tempdir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("menagerie-mo-encode-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn ok(out: &Output, what: &str) {
-    assert!(out.status.success(), "{what}: exit {:?}: {}", out.status.code(), String::from_utf8_lossy(&out.stderr));
-}
-
-fn load(path: &Path) -> (Skeleton, Motion) {
-    let parsed = bvh::read_path(path).unwrap_or_else(|e| panic!("{e}"));
-    let skeleton = Skeleton::from_bvh(&parsed);
-    let motion = Motion::from_bvh(&parsed, &skeleton);
-    (skeleton, motion)
-}
 
 /// Largest world-position difference between two motions on one skeleton.
 fn max_position_error(skeleton: &Skeleton, a: &Motion, b: &Motion) -> f64 {
@@ -336,7 +315,7 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
     for (what, input, expect) in &cases {
         let target = dir.join(format!("out-{}.bvh", what.replace(' ', "_")));
         let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bvh_path), s(input), "-o", s(&target)], None);
-        check_failure(what, &out, expect);
+        check_failure("mo-encode", what, &out, expect);
         assert!(!target.exists(), "{what}: output written despite the error");
     }
     // f8 input is accepted and converted.
@@ -347,30 +326,30 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
     // A batch needs a numbered output.
     let batch = write("batch.npy", &npy_of(&[2, 2, 2, 9], &[f.data.clone(), f.data.clone()].concat()));
     let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bvh_path), s(&batch)], None);
-    check_failure("batch to stdout", &out, "give -o a pattern");
+    check_failure("mo-encode", "batch to stdout", &out, "give -o a pattern");
     let target = dir.join("plain.bvh");
     let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&bvh_path), s(&batch), "-o", s(&target)], None);
-    check_failure("batch without {i}", &out, "numbered output path");
+    check_failure("mo-encode", "batch without {i}", &out, "numbered output path");
     assert!(!target.exists());
 
     // Skeletons that are neither documents nor BVH; documents that are broken.
     let junk = write("junk.txt", b"hello");
     let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&junk), s(&batch)], None);
-    check_failure("junk skeleton", &out, "not a skeleton");
+    check_failure("mo-encode", "junk skeleton", &out, "not a skeleton");
     let broken = write("broken.json", b"{\"format\": \"menagerie.skeleton\"");
     let out = common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(&broken), s(&batch)], None);
-    check_failure("broken document", &out, "not a skeleton document");
+    check_failure("mo-encode", "broken document", &out, "not a skeleton document");
 
     // Encoding errors: a broken BVH among good ones, a missing file; nothing written.
     let broken_bvh = write("broken.bvh", &TINY.as_bytes()[..TINY.len() - 12]);
     let target = dir.join("enc.npy");
     let out = common::run("mo-encode", &["--repr", "m2m", s(&bvh_path), s(&broken_bvh), "-o", s(&target)], None);
-    check_failure("broken BVH", &out, "broken.bvh:");
+    check_failure("mo-encode", "broken BVH", &out, "broken.bvh:");
     assert!(!target.exists());
     let out = common::run("mo-encode", &["--repr", "m2m", "/nonexistent/x.bvh", "-o", s(&target)], None);
-    check_failure("missing file", &out, "/nonexistent/x.bvh");
+    check_failure("mo-encode", "missing file", &out, "/nonexistent/x.bvh");
     let out = common::run("mo-encode", &["--repr", "m2m", "-", "-"], Some(TINY.as_bytes()));
-    check_failure("stdin twice", &out, "only once");
+    check_failure("mo-encode", "stdin twice", &out, "only once");
     // Usage errors (clap) also exit 2.
     let out = common::run("mo-encode", &["--repr", "m2m", "--decode", s(&batch)], None);
     assert_eq!(out.status.code(), Some(2));
@@ -384,14 +363,6 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
         .collect();
     assert!(leftovers.is_empty(), "temp files left behind: {leftovers:?}");
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-fn check_failure(what: &str, out: &Output, expect: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{what}: {err}");
-    assert!(err.starts_with("mo-encode: ") && err.trim_end().lines().count() == 1, "{what}: not one line: {err}");
-    assert!(err.contains(expect), "{what}: expected '{expect}' in: {err}");
-    assert!(out.stdout.is_empty(), "{what}: printed on stdout");
 }
 
 #[test]

@@ -12,6 +12,8 @@
 //!   same skeleton as the BVH path; bad input exits 2 with one line and no file.
 mod common;
 
+use common::{tempdir, schema_validator};
+
 use common::topology::{reference_distances, reference_relations};
 
 use glam::DVec3;
@@ -21,7 +23,7 @@ use menagerie::document::SkeletonDocument;
 use menagerie::motion::Motion;
 use menagerie::skeleton::{roles, topology, Skeleton};
 use menagerie::synth::SplitMix64;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// World positions must agree within this fraction of the skeleton's size.
 const TOLERANCE: f64 = 1e-6;
@@ -228,22 +230,9 @@ fn check_new_joints(name: &str, bvh: &Bvh, after: &(Skeleton, Vec<DVec3>, f64), 
 // ---------------------------------------------------------------------------------------------
 // Binary helpers
 
-fn tempdir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("menagerie-skel-aug-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn ok(out: &std::process::Output, what: &str) -> Vec<u8> {
     assert!(out.status.success(), "{what}: {}", String::from_utf8_lossy(&out.stderr));
     out.stdout.clone()
-}
-
-fn schema_validator() -> jsonschema::Validator {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/skeleton.schema.json");
-    let schema: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
-    jsonschema::validator_for(&schema).expect("schema compiles")
 }
 
 /// The binary on one clip (given as BVH text on stdin): determinism, variants, and the JSON

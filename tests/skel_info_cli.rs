@@ -3,15 +3,11 @@
 //! text output, broken pipes and atomic output behave as DESIGN.md promises.
 mod common;
 
+use common::{tempdir, schema_validator};
+
 use menagerie::bvh;
 use menagerie::document::SkeletonDocument;
 use std::path::Path;
-
-fn schema_validator() -> jsonschema::Validator {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/skeleton.schema.json");
-    let schema: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
-    jsonschema::validator_for(&schema).expect("schema compiles")
-}
 
 /// Check one BVH through the binary: schema, joint count, hierarchy round trip.
 fn check_document(path: &Path, validator: &jsonschema::Validator) {
@@ -143,9 +139,3 @@ fn usage_errors_exit_2() {
     assert!(err.starts_with("skel-info: ") && err.contains("/nonexistent/file.bvh") && err.trim_end().lines().count() == 1, "{err}");
 }
 
-fn tempdir(tag: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("menagerie-test-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}

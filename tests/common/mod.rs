@@ -77,3 +77,45 @@ pub fn run(name: &str, args: &[&str], stdin: Option<&[u8]>) -> Output {
     }
     child.wait_with_output().expect("wait for binary")
 }
+
+/// A fresh scratch directory for one test (named after the test binary and `tag`).
+pub fn tempdir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("menagerie-{}-{tag}-{}", env!("CARGO_CRATE_NAME"), std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The run succeeded (else fail with its stderr).
+pub fn ok(out: &Output, what: &str) {
+    assert!(out.status.success(), "{what}: exit {:?}: {}", out.status.code(), String::from_utf8_lossy(&out.stderr));
+}
+
+/// A failed run as the conventions require: exit 2, one line `tool: ...` containing
+/// `expect`, nothing on stdout.
+pub fn check_failure(tool: &str, what: &str, out: &Output, expect: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{what}: {err}");
+    assert!(err.starts_with(&format!("{tool}: ")) && err.trim_end().lines().count() == 1, "{what}: not one line: {err}");
+    assert!(err.contains(expect), "{what}: expected '{expect}' in: {err}");
+    assert!(out.stdout.is_empty(), "{what}: printed on stdout");
+}
+
+/// Skeleton and motion of a BVH file.
+pub fn load(path: &Path) -> (menagerie::skeleton::Skeleton, menagerie::motion::Motion) {
+    let parsed = menagerie::bvh::read_path(path).unwrap_or_else(|e| panic!("{e}"));
+    let skeleton = menagerie::skeleton::Skeleton::from_bvh(&parsed);
+    let motion = menagerie::motion::Motion::from_bvh(&parsed, &skeleton);
+    (skeleton, motion)
+}
+
+/// The skeleton document's JSON Schema, compiled.
+pub fn schema_validator() -> jsonschema::Validator {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/skeleton.schema.json");
+    let schema: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    jsonschema::validator_for(&schema).expect("schema compiles")
+}
