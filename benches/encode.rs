@@ -14,6 +14,9 @@
 //! Each measurement runs `RUNS` times over all clips of the set; frames/s is total frames over
 //! the median time. No benchmark framework, to keep dependencies at zero.
 
+mod common;
+use common::{bvh_files, median, time_runs, RUNS};
+
 use menagerie::bvh;
 use menagerie::io::npy;
 use menagerie::motion::Motion;
@@ -23,9 +26,8 @@ use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-const RUNS: usize = 7;
 
 struct Clip {
     bytes: Vec<u8>,
@@ -163,40 +165,6 @@ fn bvh_to_npy(bytes: &[u8]) -> Vec<u8> {
     let motion = Motion::from_bvh(&parsed, &skeleton);
     let f = m2m::encode(&motion);
     npy::to_bytes(&f.shape(), &f.data).unwrap()
-}
-
-fn bvh_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        let Ok(entries) = std::fs::read_dir(&d) else { continue };
-        for e in entries.flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("bvh")) {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
-fn time_runs(mut f: impl FnMut()) -> Vec<Duration> {
-    (0..RUNS)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed()
-        })
-        .collect()
-}
-
-fn median(t: &[Duration]) -> Duration {
-    let mut t = t.to_vec();
-    t.sort();
-    t[t.len() / 2]
 }
 
 /// 1234567.8 -> "1.23 M", 45678 -> "45.7 k".

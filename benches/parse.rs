@@ -7,12 +7,14 @@
 //! (closest to what the code can do). No benchmark framework, to keep dependencies at zero.
 //! Results and history are in BENCHMARKS.md.
 
+mod common;
+use common::{median, min, ms, time_runs, RUNS};
+
 use menagerie::bvh;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-const RUNS: usize = 7;
 /// Size of the synthetic input; large enough that per-call overheads vanish and the frame
 /// matrix (~37 MB of f64) is well beyond the caches, as with a long real capture.
 const SYNTHETIC_BYTES: usize = 50_000_000;
@@ -63,53 +65,13 @@ fn main() {
     }
 }
 
-fn time_runs(mut f: impl FnMut()) -> Vec<Duration> {
-    (0..RUNS)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed()
-        })
-        .collect()
-}
-
-fn median(t: &[Duration]) -> Duration {
-    let mut t = t.to_vec();
-    t.sort();
-    t[t.len() / 2]
-}
-
-fn min(t: &[Duration]) -> Duration {
-    *t.iter().min().unwrap()
-}
-
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
 fn mb_per_s(bytes: usize, d: Duration) -> f64 {
     bytes as f64 / 1e6 / d.as_secs_f64()
 }
 
 /// The largest `.bvh` file under `dir` (searched recursively), if any.
 fn largest_bvh(dir: &Path) -> Option<PathBuf> {
-    let mut best: Option<(u64, PathBuf)> = None;
-    let mut dirs = vec![dir.to_path_buf()];
-    while let Some(d) = dirs.pop() {
-        let Ok(entries) = std::fs::read_dir(&d) else { continue };
-        for e in entries.flatten() {
-            let path = e.path();
-            let Ok(meta) = e.metadata() else { continue };
-            if meta.is_dir() {
-                dirs.push(path);
-            } else if path.extension().is_some_and(|x| x.eq_ignore_ascii_case("bvh"))
-                && best.as_ref().is_none_or(|(size, _)| meta.len() > *size)
-            {
-                best = Some((meta.len(), path));
-            }
-        }
-    }
-    best.map(|(_, p)| p)
+    common::bvh_files(dir).into_iter().max_by_key(|p| std::fs::metadata(p).map_or(0, |m| m.len()))
 }
 
 /// A deterministic BVH of about `target` bytes: a root with 6 channels and a chain-and-branches

@@ -2,7 +2,8 @@
 //! clap commands of all tools (so man pages and completions are generated from the very
 //! definitions that parse the arguments).
 //!
-//! Exit codes: 0 ok; 1 a valid but negative answer; 2 usage, I/O or data error. Errors print
+//! Exit codes: 0 ok; 2 usage, I/O or data error (1, a valid negative answer, arrives with the
+//! first tool that has one, e.g. a metrics check). Errors print
 //! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
 pub mod docs;
@@ -42,17 +43,6 @@ impl CommonOpts {
     }
 }
 
-/// An error that should exit with a specific code (1 = negative answer, 2 = failure).
-#[derive(Debug)]
-pub struct Exit(pub u8);
-
-impl std::fmt::Display for Exit {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "exit {}", self.0)
-    }
-}
-impl std::error::Error for Exit {}
-
 /// Run a tool's body and turn its result into an exit code, printing errors as one line.
 pub fn finish(tool: &str, result: anyhow::Result<()>) -> ExitCode {
     match result {
@@ -60,9 +50,6 @@ pub fn finish(tool: &str, result: anyhow::Result<()>) -> ExitCode {
         Err(e) => {
             if is_broken_pipe(&e) {
                 return ExitCode::SUCCESS;
-            }
-            if let Some(Exit(code)) = e.downcast_ref::<Exit>() {
-                return ExitCode::from(*code);
             }
             let msg = format!("{e:#}").replace('\n', " ");
             eprintln!("{tool}: {msg}");
