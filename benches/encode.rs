@@ -121,8 +121,7 @@ fn main() {
         let rigged: Vec<(&Clip, AnyTopRig, Encoded)> = clips
             .iter()
             .filter_map(|c| {
-                let rest = Motion { frames: 1, rotations: c.motion.rotations[..c.motion.joints].to_vec(), translations: c.motion.translations[..c.motion.joints].to_vec(), ..c.motion.clone() };
-                let rig = AnyTopRig::new(&c.skeleton, &rest, &AnyTopOptions::default()).ok()?;
+                let rig = AnyTopRig::new(&c.skeleton, &c.motion.first_frames(1), &AnyTopOptions::default()).ok()?;
                 let encoded = rig.encode(&c.skeleton, &c.motion).ok()?;
                 Some((c, rig, encoded))
             })

@@ -53,19 +53,27 @@ pub struct AnyTopSection {
 }
 
 impl AnyTopSection {
-    /// Rig from `rest` (its frame 0 is the rest pose, frame 1 gives P_S its velocity), and
-    /// statistics over `clips` (those with at least two frames).
-    pub fn build(skeleton: &Skeleton, rest: &Motion, source: RestSource, clips: &[&Motion]) -> Result<AnyTopSection, AnyTopError> {
-        let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
-        let rig = AnyTopRig::new(skeleton, rest, &options)?;
+    /// Rig and P_S from `rest` (its frame 0 is the rest pose, frame 1 gives P_S its velocity),
+    /// without statistics.
+    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &AnyTopOptions) -> Result<AnyTopSection, AnyTopError> {
+        let rig = AnyTopRig::new(skeleton, rest, options)?;
         let row = rig.rest_features(skeleton, rest)?;
         let rest_row = (0..row.joints).map(|j| row.at(0, j).to_vec()).collect();
+        Ok(AnyTopSection { rig, rest_row, stats: None })
+    }
+
+    /// `new` with default options, plus statistics over `clips` (those with at least two frames).
+    pub fn build(skeleton: &Skeleton, rest: &Motion, source: RestSource, clips: &[&Motion]) -> Result<AnyTopSection, AnyTopError> {
+        let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
+        let mut section = AnyTopSection::new(skeleton, rest, &options)?;
         let mut features = Vec::new();
         for clip in clips.iter().filter(|m| m.frames >= 2) {
-            features.push(rig.encode(skeleton, clip)?.features);
+            features.push(section.rig.encode(skeleton, clip)?.features);
         }
-        let stats = if features.is_empty() { None } else { Some(AnyTopStats::compute(features.iter())?) };
-        Ok(AnyTopSection { rig, rest_row, stats })
+        if !features.is_empty() {
+            section.stats = Some(AnyTopStats::compute(features.iter())?);
+        }
+        Ok(section)
     }
 }
 

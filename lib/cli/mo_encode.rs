@@ -294,25 +294,7 @@ fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<Clip> {
     let skeleton = Skeleton::from_bvh(&parsed);
     let motion = Motion::from_bvh_frames(&parsed, &skeleton, 0..frames.unwrap_or(usize::MAX));
     let info = MotionInfo::of(&parsed, &skeleton);
-    Ok(Clip { tpose: !is_dash(path) && names_tpose(path), name, skeleton, motion, info })
-}
-
-/// AnyTop's T-pose rule: the file name contains 'tpos', in any case.
-fn names_tpose(path: &Path) -> bool {
-    path.file_name().is_some_and(|f| f.to_string_lossy().to_lowercase().contains("tpos"))
-}
-
-/// The first `n` frames of a motion (all when it has fewer).
-fn first_frames(m: &Motion, n: usize) -> Motion {
-    let n = n.min(m.frames);
-    let k = n * m.joints;
-    Motion {
-        frames: n,
-        joints: m.joints,
-        frame_time: m.frame_time,
-        rotations: m.rotations[..k].to_vec(),
-        translations: m.translations[..k].to_vec(),
-    }
+    Ok(Clip { tpose: !is_dash(path) && anytop::names_tpose(&path.to_string_lossy()), name, skeleton, motion, info })
 }
 
 /// AnyTop encodes one skeleton per call: same joint names and parents.
@@ -468,13 +450,12 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
                 },
             };
             let options = anytop_options(args, &rest.skeleton, &rest.name, source)?;
-            let rest_motion = first_frames(&rest.motion, 2);
-            let (rig, rest_row) = build_rig(&rest.skeleton, &rest_motion, &options)
+            let section = AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options)
                 .with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
             // The document describes the encoded clips (their frame time), with the rig.
             let document =
                 SkeletonDocument::build(&first.skeleton, first.info.clone(), &first.name, topology::DEFAULT_DMAX);
-            (document, AnyTopSection { rig, rest_row, stats: None }, rest.name.clone())
+            (document, section, rest.name.clone())
         }
     };
     let rig = &section.rig;
@@ -652,7 +633,7 @@ fn read_skeleton(path: &Path) -> anyhow::Result<SkeletonArg> {
         skeleton.validate().with_context(|| name.clone())?;
         let document = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, topology::DEFAULT_DMAX);
         let motion = Some(Motion::from_bvh(&parsed, &skeleton));
-        Ok(SkeletonArg { tpose: !is_dash(path) && names_tpose(path), name, skeleton, document, motion })
+        Ok(SkeletonArg { tpose: !is_dash(path) && anytop::names_tpose(&path.to_string_lossy()), name, skeleton, document, motion })
     } else {
         let start: String = body.iter().take(12).flat_map(|&b| std::ascii::escape_default(b)).map(char::from).collect();
         bail!("{name}: not a skeleton: expected a skeleton document (JSON from skel-info) or a BVH file, found '{start}'")
@@ -683,33 +664,23 @@ fn record_of(arg: &SkeletonArg, rest_pose: Option<&Clip>, args: &Args, want_stat
     let (rest, source) = match (rest_pose, &arg.motion) {
         (Some(clip), _) => {
             check_same_skeleton(&arg.name, &arg.skeleton, &clip.name, &clip.skeleton)?;
-            (first_frames(&clip.motion, 2), RestSource::Explicit { file: clip.name.clone() })
+            (clip.motion.first_frames(2), RestSource::Explicit { file: clip.name.clone() })
         }
         (None, Some(motion)) if motion.frames > 0 => {
             let file = arg.name.clone();
-            (first_frames(motion, 2), if arg.tpose { RestSource::TPose { file } } else { RestSource::FirstClip { file } })
+            (motion.first_frames(2), if arg.tpose { RestSource::TPose { file } } else { RestSource::FirstClip { file } })
         }
         _ => (Motion::rest(&arg.skeleton), RestSource::Offsets),
     };
     let options = anytop_options(args, &arg.skeleton, &arg.name, source)?;
-    let (rig, rest_row) =
-        build_rig(&arg.skeleton, &rest, &options).with_context(|| format!("{}: cannot build an AnyTop rig", arg.name))?;
-    let stats = match &arg.motion {
-        Some(motion) if want_stats && motion.frames >= 2 => {
-            let own = rig.encode(&arg.skeleton, motion).with_context(|| format!("{}: statistics of its motion", arg.name))?;
-            Some(AnyTopStats::compute([&own.features]).with_context(|| format!("{}: statistics of its motion", arg.name))?)
-        }
-        _ => None,
-    };
-    Ok(AnyTopSection { rig, rest_row, stats })
-}
-
-/// A rig and its rest-pose row P_S (`AnyTopSection::build`, with options).
-fn build_rig(skeleton: &Skeleton, rest: &Motion, options: &AnyTopOptions) -> Result<(AnyTopRig, Vec<Vec<f32>>), anytop::AnyTopError> {
-    let rig = AnyTopRig::new(skeleton, rest, options)?;
-    let row = rig.rest_features(skeleton, rest)?;
-    let rest_row = (0..row.joints).map(|j| row.at(0, j).to_vec()).collect();
-    Ok((rig, rest_row))
+    let mut section =
+        AnyTopSection::new(&arg.skeleton, &rest, &options).with_context(|| format!("{}: cannot build an AnyTop rig", arg.name))?;
+    if let Some(motion) = arg.motion.as_ref().filter(|m| want_stats && m.frames >= 2) {
+        let own = section.rig.encode(&arg.skeleton, motion).with_context(|| format!("{}: statistics of its motion", arg.name))?;
+        section.stats =
+            Some(AnyTopStats::compute([&own.features]).with_context(|| format!("{}: statistics of its motion", arg.name))?);
+    }
+    Ok(section)
 }
 
 /// The override flags as rig options, joint names resolved on `skeleton` (from `file`).

@@ -3,7 +3,7 @@
 use crate::cli::CommonOpts;
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
 use crate::motion::Motion;
-use crate::repr::anytop::RestSource;
+use crate::repr::anytop::{self, RestSource};
 use crate::skeleton::names::Side;
 use crate::skeleton::{topology, Skeleton};
 use crate::{bvh, io};
@@ -121,8 +121,8 @@ fn anytop_section(
         }
         None if parsed.frames > 0 => {
             let file = name.to_string();
-            let source = if file.to_lowercase().contains("tpos") { RestSource::TPose { file } } else { RestSource::FirstClip { file } };
-            (Motion::from_bvh_frames(parsed, skeleton, 0..2), source)
+            let source = if anytop::names_tpose(&file) { RestSource::TPose { file } } else { RestSource::FirstClip { file } };
+            (motion.first_frames(2), source)
         }
         None => (Motion::rest(skeleton), RestSource::Offsets),
     };

@@ -76,6 +76,19 @@ impl Motion {
         Motion { frames: frames.len(), joints: nj, frame_time: bvh.frame_time, rotations, translations }
     }
 
+    /// The first `n` frames (all of them when there are fewer).
+    pub fn first_frames(&self, n: usize) -> Motion {
+        let n = n.min(self.frames);
+        let k = n * self.joints;
+        Motion {
+            frames: n,
+            joints: self.joints,
+            frame_time: self.frame_time,
+            rotations: self.rotations[..k].to_vec(),
+            translations: self.translations[..k].to_vec(),
+        }
+    }
+
     /// The skeleton's rest pose as a one-frame motion (identity rotations, OFFSET translations).
     pub fn rest(skeleton: &Skeleton) -> Motion {
         Motion {
