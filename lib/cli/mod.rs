@@ -8,6 +8,8 @@
 
 pub mod docs;
 pub mod mo_encode;
+pub mod mo_metrics;
+pub mod mo_render;
 pub mod skel_aug;
 pub mod skel_info;
 
@@ -65,5 +67,11 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 /// Every tool's clap command, for man pages, completions and help tests.
 pub fn all_commands() -> Vec<clap::Command> {
     use clap::CommandFactory;
-    vec![skel_info::Args::command(), skel_aug::Args::command(), mo_encode::Args::command()]
+    vec![
+        skel_info::Args::command(),
+        skel_aug::Args::command(),
+        mo_encode::Args::command(),
+        mo_render::Args::command(),
+        mo_metrics::Args::command(),
+    ]
 }

@@ -52,6 +52,8 @@ pub fn bin(name: &str) -> Command {
         "skel-info" => env!("CARGO_BIN_EXE_skel-info"),
         "skel-aug" => env!("CARGO_BIN_EXE_skel-aug"),
         "mo-encode" => env!("CARGO_BIN_EXE_mo-encode"),
+        "mo-render" => env!("CARGO_BIN_EXE_mo-render"),
+        "mo-metrics" => env!("CARGO_BIN_EXE_mo-metrics"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);
