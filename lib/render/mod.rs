@@ -137,3 +137,20 @@ pub fn palette(i: usize) -> [u8; 3] {
     ];
     COLOURS[i % COLOURS.len()]
 }
+
+/// Why a picture cannot be drawn.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum RenderError {
+    /// Nothing to draw: no tracks, or a track without frames or points (names the track).
+    #[error("{0}")]
+    Empty(String),
+    /// A NaN or infinite position (names the track, frame and point).
+    #[error("{0}")]
+    NonFinite(String),
+    /// The requested picture would be unreasonably large (says how large and the limit).
+    #[error("{0}")]
+    TooLarge(String),
+    /// Options that contradict each other or the input (a label index outside the legend...).
+    #[error("{0}")]
+    Invalid(String),
+}
