@@ -20,19 +20,20 @@
 //! atomically, and a failed write removes the outputs of the call already written, so an
 //! error never leaves a partial output.
 
+use crate::cli::load::{is_dash, read_skeleton, split_samples, Decoder, SkeletonArg};
+pub use crate::cli::load::{load_skeleton, DecodeFrom};
 use crate::cli::CommonOpts;
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
-use crate::io::npy::{self, NpyArray};
+use crate::io::npy;
 use crate::motion::Motion;
 use crate::repr::anytop::{
-    self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, IkOptions, Placement, Provenance, RestSource,
+    self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource,
 };
 use crate::repr::{m2m, Features};
 use crate::skeleton::{topology, Skeleton};
 use crate::{bvh, io};
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
-use std::borrow::Cow;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
@@ -200,15 +201,6 @@ impl Repr {
     }
 }
 
-/// Where AnyTop decoding takes the rotations from.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DecodeFrom {
-    /// The features' 6D rotations: exact for encoded features.
-    Rotations,
-    /// The features' joint positions, by inverse kinematics: for generated features.
-    Positions,
-}
-
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
     refuse_anytop_flags(args)?;
@@ -243,10 +235,6 @@ fn refuse_anytop_flags(args: &Args) -> anyhow::Result<()> {
         Some((_, flag)) => bail!("{flag} belongs to --repr anytop: m2m features need no rig, placement or statistics"),
         None => Ok(()),
     }
-}
-
-fn is_dash(p: &Path) -> bool {
-    p.as_os_str() == "-"
 }
 
 /// Everything that reads stdin, refused when more than one thing would.
@@ -605,46 +593,6 @@ fn refuse_terminal(output: Option<&Path>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// What `--skeleton` names: a skeleton document, or a BVH file standing for the document
-/// `skel-info` would print for it.
-struct SkeletonArg {
-    name: String,
-    skeleton: Skeleton,
-    document: SkeletonDocument,
-    /// A BVH's motion (its rest frames and statistics); `None` for a document.
-    motion: Option<Motion>,
-    /// A BVH named like a T-pose.
-    tpose: bool,
-}
-
-/// Read `--skeleton`, recognised by content.
-fn read_skeleton(path: &Path) -> anyhow::Result<SkeletonArg> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read skeleton {name}"))?;
-    let body = bytes.strip_prefix(b"\xEF\xBB\xBF".as_slice()).unwrap_or(&bytes).trim_ascii_start();
-    if body.starts_with(b"{") {
-        let text = std::str::from_utf8(body).with_context(|| format!("{name}: skeleton document is not UTF-8"))?;
-        let document = SkeletonDocument::from_json(text).with_context(|| name.clone())?;
-        let skeleton = document.skeleton().with_context(|| name.clone())?;
-        Ok(SkeletonArg { name, skeleton, document, motion: None, tpose: false })
-    } else if body.len() >= 9 && body[..9].eq_ignore_ascii_case(b"HIERARCHY") {
-        let parsed = bvh::parse_bytes(&bytes, &name)?;
-        let skeleton = Skeleton::from_bvh(&parsed);
-        skeleton.validate().with_context(|| name.clone())?;
-        let document = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, topology::DEFAULT_DMAX);
-        let motion = Some(Motion::from_bvh(&parsed, &skeleton));
-        Ok(SkeletonArg { tpose: !is_dash(path) && anytop::names_tpose(&path.to_string_lossy()), name, skeleton, document, motion })
-    } else {
-        let start: String = body.iter().take(12).flat_map(|&b| std::ascii::escape_default(b)).map(char::from).collect();
-        bail!("{name}: not a skeleton: expected a skeleton document (JSON from skel-info) or a BVH file, found '{start}'")
-    }
-}
-
-/// A skeleton from a skeleton document (JSON) or a BVH file, recognised by content.
-pub fn load_skeleton(path: &Path) -> anyhow::Result<Skeleton> {
-    Ok(read_skeleton(path)?.skeleton)
-}
-
 /// The AnyTop record `--skeleton` stands for, the same way when encoding and decoding: the
 /// document's own record; else one built (with the override flags) as `skel-info` builds it,
 /// on frame 0 of `rest_pose` when given, else of the BVH, else (a document without motion) on
@@ -661,16 +609,12 @@ fn record_of(arg: &SkeletonArg, rest_pose: Option<&Clip>, args: &Args, want_stat
         }
         return Ok(section.clone());
     }
-    let (rest, source) = match (rest_pose, &arg.motion) {
-        (Some(clip), _) => {
+    let (rest, source) = match rest_pose {
+        Some(clip) => {
             check_same_skeleton(&arg.name, &arg.skeleton, &clip.name, &clip.skeleton)?;
             (clip.motion.first_frames(2), RestSource::Explicit { file: clip.name.clone() })
         }
-        (None, Some(motion)) if motion.frames > 0 => {
-            let file = arg.name.clone();
-            (motion.first_frames(2), if arg.tpose { RestSource::TPose { file } } else { RestSource::FirstClip { file } })
-        }
-        _ => (Motion::rest(&arg.skeleton), RestSource::Offsets),
+        None => arg.own_rest(),
     };
     let options = anytop_options(args, &arg.skeleton, &arg.name, source)?;
     let mut section =
@@ -804,79 +748,6 @@ fn describe_rig(rig: &AnyTopRig, skeleton: &Skeleton) -> String {
     )
 }
 
-/// How the samples of one NPY go back to motion.
-enum Decoder {
-    M2m,
-    AnyTop {
-        rig: Box<AnyTopRig>,
-        /// Undo `--normalise` first.
-        stats: Option<AnyTopStats>,
-        /// One per sample.
-        placements: Vec<Placement>,
-        from: DecodeFrom,
-    },
-}
-
-impl Decoder {
-    /// Shape and value checks, so a batch is refused before anything is written; on failure,
-    /// what is wrong and a hint (may be empty).
-    fn check(&self, features: &Features, skeleton: &Skeleton) -> Result<(), (String, &'static str)> {
-        match self {
-            Decoder::M2m => m2m::check(features, skeleton).map_err(|e| {
-                let hint = if features.dims == anytop::FEATURE_DIMS { ": AnyTop features? decode them without --repr m2m" } else { "" };
-                (e.to_string(), hint)
-            }),
-            Decoder::AnyTop { .. } => check_anytop(features, skeleton),
-        }
-    }
-
-    fn repr(&self) -> Repr {
-        match self {
-            Decoder::M2m => Repr::M2m,
-            Decoder::AnyTop { .. } => Repr::Anytop,
-        }
-    }
-
-    fn decode(&self, i: usize, features: &Features, skeleton: &Skeleton) -> Result<Motion, String> {
-        match self {
-            Decoder::M2m => m2m::decode(features, skeleton).map_err(|e| e.to_string()),
-            Decoder::AnyTop { rig, stats, placements, from } => {
-                let features = match stats {
-                    Some(stats) => {
-                        let mut f = features.clone();
-                        stats.denormalise(&mut f).map_err(|e| format!("cannot undo the normalisation: {e}"))?;
-                        Cow::Owned(f)
-                    }
-                    None => Cow::Borrowed(features),
-                };
-                let placement = &placements[i];
-                match from {
-                    DecodeFrom::Rotations => rig.decode(skeleton, &features, placement),
-                    DecodeFrom::Positions => rig.decode_ik(skeleton, &features, placement, &IkOptions::default()),
-                }
-                .map_err(|e| e.to_string())
-            }
-        }
-    }
-}
-
-/// AnyTop's shape and value checks, worded like m2m's.
-fn check_anytop(features: &Features, skeleton: &Skeleton) -> Result<(), (String, &'static str)> {
-    if features.dims != anytop::FEATURE_DIMS {
-        let hint = if features.dims == m2m::DIMS { ": Motion2Motion features? decode them with --repr m2m" } else { "" };
-        return Err((format!("AnyTop features have {} dims per joint, found {}", anytop::FEATURE_DIMS, features.dims), hint));
-    }
-    if features.joints != skeleton.len() {
-        return Err((format!("the features have {} joints but the skeleton has {}", features.joints, skeleton.len()), ""));
-    }
-    if let Some((frame, joint, dim)) = features.first_non_finite() {
-        let value = features.at(frame, joint)[dim];
-        let name = &skeleton.joints[joint].name;
-        return Err((format!("non-finite value {value} at frame {frame}, joint {joint} '{name}', dim {dim}"), ""));
-    }
-    Ok(())
-}
-
 fn decode(args: &Args) -> anyhow::Result<()> {
     let input = match args.inputs.as_slice() {
         [] => PathBuf::from("-"),
@@ -920,7 +791,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     let label = |i: usize| if batch { format!("{name}: sample {i}") } else { name.clone() };
     for (i, f) in samples.iter().enumerate() {
         decoder.check(f, skeleton).map_err(|(e, hint)| {
-            anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr().name(), arg.name)
+            anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name)
         })?;
     }
     let target = args.common.output.as_deref();
@@ -956,21 +827,3 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     write_outputs(paths.into_iter().zip(texts.into_iter().map(String::into_bytes)).collect())
 }
 
-/// Rank 3 -> one motion; rank 4 -> one per sample (`true`: the input was a batch).
-fn split_samples(array: NpyArray, name: &str) -> anyhow::Result<(Vec<Features>, bool)> {
-    match array.shape.as_slice() {
-        &[frames, joints, dims] => Ok((vec![Features { frames, joints, dims, data: array.data }], false)),
-        &[n, frames, joints, dims] => {
-            if n == 0 {
-                bail!("{name}: the batch holds no samples (shape {:?})", array.shape);
-            }
-            let per = frames * joints * dims;
-            let samples = (0..n).map(|i| Features { frames, joints, dims, data: array.data[i * per..(i + 1) * per].to_vec() }).collect();
-            Ok((samples, true))
-        }
-        shape => bail!(
-            "{name}: expected a [frames, joints, dims] or [samples, frames, joints, dims] array, found shape {shape:?} (rank {})",
-            shape.len()
-        ),
-    }
-}

@@ -1,0 +1,293 @@
+//! Reading motion for the tools that consume it: BVH files, or NPY feature tensors decoded on a
+//! skeleton (a skeleton document, or a BVH standing for the document `skel-info` prints).
+//!
+//! `mo-encode --decode` and every tool that *looks at* motion (`mo-render`, `mo-metrics`) go
+//! through the same code here, so an NPY decodes to the same joint positions everywhere.
+
+use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
+use crate::io::npy::{self, NpyArray};
+use crate::motion::Motion;
+use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, IkOptions, Placement, RestSource};
+use crate::repr::{m2m, Features};
+use crate::skeleton::{topology, Skeleton};
+use crate::{bvh, io};
+use anyhow::{anyhow, bail, Context};
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+
+
+/// Where AnyTop decoding takes the rotations from.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DecodeFrom {
+    /// The features' 6D rotations: exact for encoded features.
+    Rotations,
+    /// The features' joint positions, by inverse kinematics: for generated features.
+    Positions,
+}
+
+/// `-` means stdin/stdout.
+pub fn is_dash(p: &Path) -> bool {
+    p.as_os_str() == "-"
+}
+
+/// What `--skeleton` names: a skeleton document, or a BVH file standing for the document
+/// `skel-info` would print for it.
+pub struct SkeletonArg {
+    pub name: String,
+    pub skeleton: Skeleton,
+    pub document: SkeletonDocument,
+    /// A BVH's motion (its rest frames and statistics); `None` for a document.
+    pub motion: Option<Motion>,
+    /// A BVH named like a T-pose.
+    pub tpose: bool,
+}
+
+/// Read `--skeleton`, recognised by content.
+pub fn read_skeleton(path: &Path) -> anyhow::Result<SkeletonArg> {
+    let name = io::display_name(path);
+    let bytes = io::read_input(path).with_context(|| format!("cannot read skeleton {name}"))?;
+    let body = bytes.strip_prefix(b"\xEF\xBB\xBF".as_slice()).unwrap_or(&bytes).trim_ascii_start();
+    if body.starts_with(b"{") {
+        let text = std::str::from_utf8(body).with_context(|| format!("{name}: skeleton document is not UTF-8"))?;
+        let document = SkeletonDocument::from_json(text).with_context(|| name.clone())?;
+        let skeleton = document.skeleton().with_context(|| name.clone())?;
+        Ok(SkeletonArg { name, skeleton, document, motion: None, tpose: false })
+    } else if body.len() >= 9 && body[..9].eq_ignore_ascii_case(b"HIERARCHY") {
+        let parsed = bvh::parse_bytes(&bytes, &name)?;
+        let skeleton = Skeleton::from_bvh(&parsed);
+        skeleton.validate().with_context(|| name.clone())?;
+        let document = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, topology::DEFAULT_DMAX);
+        let motion = Some(Motion::from_bvh(&parsed, &skeleton));
+        Ok(SkeletonArg { tpose: !is_dash(path) && anytop::names_tpose(&path.to_string_lossy()), name, skeleton, document, motion })
+    } else {
+        let start: String = body.iter().take(12).flat_map(|&b| std::ascii::escape_default(b)).map(char::from).collect();
+        bail!("{name}: not a skeleton: expected a skeleton document (JSON from skel-info) or a BVH file, found '{start}'")
+    }
+}
+
+/// A skeleton from a skeleton document (JSON) or a BVH file, recognised by content.
+pub fn load_skeleton(path: &Path) -> anyhow::Result<Skeleton> {
+    Ok(read_skeleton(path)?.skeleton)
+}
+
+/// How the samples of one NPY go back to motion.
+pub enum Decoder {
+    M2m,
+    AnyTop {
+        rig: Box<AnyTopRig>,
+        /// Undo `--normalise` first.
+        stats: Option<AnyTopStats>,
+        /// One per sample.
+        placements: Vec<Placement>,
+        from: DecodeFrom,
+    },
+}
+
+impl Decoder {
+    /// Shape and value checks, so a batch is refused before anything is written; on failure,
+    /// what is wrong and a hint (may be empty).
+    pub fn check(&self, features: &Features, skeleton: &Skeleton) -> Result<(), (String, &'static str)> {
+        match self {
+            Decoder::M2m => m2m::check(features, skeleton).map_err(|e| {
+                let hint = if features.dims == anytop::FEATURE_DIMS { ": AnyTop features? decode them without --repr m2m" } else { "" };
+                (e.to_string(), hint)
+            }),
+            Decoder::AnyTop { .. } => check_anytop(features, skeleton),
+        }
+    }
+
+    /// The representation's name, as `--repr` spells it.
+    pub fn repr_name(&self) -> &'static str {
+        match self {
+            Decoder::M2m => "m2m",
+            Decoder::AnyTop { .. } => "anytop",
+        }
+    }
+
+    pub fn decode(&self, i: usize, features: &Features, skeleton: &Skeleton) -> Result<Motion, String> {
+        match self {
+            Decoder::M2m => m2m::decode(features, skeleton).map_err(|e| e.to_string()),
+            Decoder::AnyTop { rig, stats, placements, from } => {
+                let features = match stats {
+                    Some(stats) => {
+                        let mut f = features.clone();
+                        stats.denormalise(&mut f).map_err(|e| format!("cannot undo the normalisation: {e}"))?;
+                        Cow::Owned(f)
+                    }
+                    None => Cow::Borrowed(features),
+                };
+                let placement = &placements[i];
+                match from {
+                    DecodeFrom::Rotations => rig.decode(skeleton, &features, placement),
+                    DecodeFrom::Positions => rig.decode_ik(skeleton, &features, placement, &IkOptions::default()),
+                }
+                .map_err(|e| e.to_string())
+            }
+        }
+    }
+}
+
+/// AnyTop's shape and value checks, worded like m2m's.
+fn check_anytop(features: &Features, skeleton: &Skeleton) -> Result<(), (String, &'static str)> {
+    if features.dims != anytop::FEATURE_DIMS {
+        let hint = if features.dims == m2m::DIMS { ": Motion2Motion features? decode them with --repr m2m" } else { "" };
+        return Err((format!("AnyTop features have {} dims per joint, found {}", anytop::FEATURE_DIMS, features.dims), hint));
+    }
+    if features.joints != skeleton.len() {
+        return Err((format!("the features have {} joints but the skeleton has {}", features.joints, skeleton.len()), ""));
+    }
+    if let Some((frame, joint, dim)) = features.first_non_finite() {
+        let value = features.at(frame, joint)[dim];
+        let name = &skeleton.joints[joint].name;
+        return Err((format!("non-finite value {value} at frame {frame}, joint {joint} '{name}', dim {dim}"), ""));
+    }
+    Ok(())
+}
+
+/// Rank 3 -> one motion; rank 4 -> one per sample (`true`: the input was a batch).
+pub fn split_samples(array: NpyArray, name: &str) -> anyhow::Result<(Vec<Features>, bool)> {
+    match array.shape.as_slice() {
+        &[frames, joints, dims] => Ok((vec![Features { frames, joints, dims, data: array.data }], false)),
+        &[n, frames, joints, dims] => {
+            if n == 0 {
+                bail!("{name}: the batch holds no samples (shape {:?})", array.shape);
+            }
+            let per = frames * joints * dims;
+            let samples = (0..n).map(|i| Features { frames, joints, dims, data: array.data[i * per..(i + 1) * per].to_vec() }).collect();
+            Ok((samples, true))
+        }
+        shape => bail!(
+            "{name}: expected a [frames, joints, dims] or [samples, frames, joints, dims] array, found shape {shape:?} (rank {})",
+            shape.len()
+        ),
+    }
+}
+
+impl SkeletonArg {
+    /// The rest pose a rig is built on when nobody names one (AnyTop's rule, as `skel-info`
+    /// applies it): frames 0-1 of the BVH, else the OFFSET pose of a document.
+    pub fn own_rest(&self) -> (Motion, RestSource) {
+        match &self.motion {
+            Some(motion) if motion.frames > 0 => {
+                let file = self.name.clone();
+                (motion.first_frames(2), if self.tpose { RestSource::TPose { file } } else { RestSource::FirstClip { file } })
+            }
+            _ => (Motion::rest(&self.skeleton), RestSource::Offsets),
+        }
+    }
+
+    /// The AnyTop record this skeleton stands for, without override flags: the document's own
+    /// record, else one built on `own_rest` with the default options (no statistics).
+    pub fn record(&self) -> anyhow::Result<AnyTopSection> {
+        if let Some(section) = &self.document.anytop {
+            return Ok(section.clone());
+        }
+        let (rest, rest_source) = self.own_rest();
+        let options = AnyTopOptions { rest_source, ..AnyTopOptions::default() };
+        AnyTopSection::new(&self.skeleton, &rest, &options).with_context(|| format!("{}: cannot build an AnyTop rig", self.name))
+    }
+}
+
+/// One motion read from a file: a BVH, or one sample of an NPY decoded on a skeleton.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// File name, with `[i]` for the samples of an NPY batch.
+    pub name: String,
+    pub skeleton: Skeleton,
+    pub motion: Motion,
+}
+
+/// How `load_motions` reads NPY inputs.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LoadOptions<'a> {
+    /// The skeleton NPY features are decoded on (document or BVH); BVH inputs ignore it.
+    pub skeleton: Option<&'a Path>,
+    /// AnyTop features: decode from rotations (default) or positions.
+    pub from: Option<DecodeFrom>,
+}
+
+/// Files named by the command line: files as given, directories as the BVH and NPY files
+/// directly inside them (sorted by name, so the order never depends on the file system).
+pub fn expand_inputs(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let entries = std::fs::read_dir(input).with_context(|| format!("cannot list {}", input.display()))?;
+            let mut files: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file() && p.extension().is_some_and(|x| x.eq_ignore_ascii_case("bvh") || x.eq_ignore_ascii_case("npy")))
+                .collect();
+            if files.is_empty() {
+                bail!("{}: the directory holds no .bvh or .npy files", input.display());
+            }
+            files.sort();
+            out.extend(files);
+        } else {
+            out.push(input.clone());
+        }
+    }
+    if out.iter().filter(|p| is_dash(p)).count() > 1 {
+        bail!("stdin ('-') can be read only once");
+    }
+    Ok(out)
+}
+
+/// Read motions from BVH files and NPY feature files (recognised by content), in input order.
+/// NPY inputs need `options.skeleton`; a batch `[n, frames, joints, dims]` gives n motions.
+/// AnyTop features (13 dims) decode with the skeleton's AnyTop record and each clip at the rest
+/// placement (features do not say where a clip stood); Motion2Motion features (9 dims) decode
+/// as `mo-encode --repr m2m --decode` does.
+pub fn load_motions(inputs: &[PathBuf], options: &LoadOptions) -> anyhow::Result<Vec<Loaded>> {
+    use rayon::prelude::*;
+    let skeleton = std::sync::OnceLock::new();
+    let read_one = |path: &PathBuf| -> anyhow::Result<Vec<Loaded>> {
+        let name = io::display_name(path);
+        let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+        if bytes.starts_with(b"\x93NUMPY") {
+            let path = options.skeleton.with_context(|| format!("{name} is an NPY feature file: give --skeleton (a skeleton document or BVH) to decode it"))?;
+            let arg = match skeleton.get_or_init(|| read_skeleton(path).map_err(|e| format!("{e:#}"))) {
+                Ok(arg) => arg,
+                Err(e) => bail!("{e}"),
+            };
+            let array = npy::from_bytes(&bytes, &name)?;
+            drop(bytes);
+            decode_npy(array, &name, arg, options.from.unwrap_or(DecodeFrom::Rotations))
+        } else {
+            let parsed = bvh::parse_bytes(&bytes, &name)?;
+            drop(bytes);
+            let skeleton = Skeleton::from_bvh(&parsed);
+            skeleton.validate().with_context(|| name.clone())?;
+            let motion = Motion::from_bvh(&parsed, &skeleton);
+            Ok(vec![Loaded { name, skeleton, motion }])
+        }
+    };
+    let loaded: Vec<anyhow::Result<Vec<Loaded>>> = inputs.par_iter().map(read_one).collect();
+    let mut out = Vec::new();
+    for l in loaded {
+        out.extend(l?);
+    }
+    Ok(out)
+}
+
+/// The samples of one NPY as motions on `arg`'s skeleton.
+fn decode_npy(array: NpyArray, name: &str, arg: &SkeletonArg, from: DecodeFrom) -> anyhow::Result<Vec<Loaded>> {
+    let (samples, batch) = split_samples(array, name)?;
+    let dims = samples[0].dims;
+    let decoder = if dims == m2m::DIMS {
+        Decoder::M2m
+    } else {
+        let section = arg.record()?;
+        let placements = vec![section.rig.rest_placement(); samples.len()];
+        Decoder::AnyTop { rig: Box::new(section.rig), stats: None, placements, from }
+    };
+    let label = |i: usize| if batch { format!("{name}[{i}]") } else { name.to_string() };
+    let mut out = Vec::with_capacity(samples.len());
+    for (i, f) in samples.iter().enumerate() {
+        decoder.check(f, &arg.skeleton).map_err(|(e, hint)| {
+            anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name)
+        })?;
+        let motion = decoder.decode(i, f, &arg.skeleton).map_err(|e| anyhow!("{}: {e}", label(i)))?;
+        out.push(Loaded { name: label(i), skeleton: arg.skeleton.clone(), motion });
+    }
+    Ok(out)
+}
