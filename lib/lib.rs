@@ -4,6 +4,7 @@
 //! `motion`), then documents and I/O (`document`, `io`), then tools (`synth`, `cli`).
 
 pub mod augment;
+pub mod binding;
 pub mod bvh;
 pub mod cli;
 pub mod document;

@@ -30,7 +30,7 @@ use crate::repr::anytop::{
     self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource,
 };
 use crate::repr::{m2m, Features};
-use crate::skeleton::{topology, Skeleton};
+use crate::skeleton::{lookup, topology, Skeleton};
 use crate::{bvh, io};
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
@@ -656,73 +656,19 @@ fn anytop_options(args: &Args, skeleton: &Skeleton, file: &str, rest_source: Res
     Ok(options)
 }
 
-/// Joint indices of names given on the command line: the exact name, else the one joint whose
-/// name matches ignoring case, else ignoring case and a 'namespace:' prefix. An unknown name is
-/// an error that lists the closest real names.
+/// Joint indices of names given on the command line (`skeleton::lookup::find_joint`).
 fn joint_indices(flag: &str, names: &[String], skeleton: &Skeleton, file: &str) -> anyhow::Result<Vec<usize>> {
     if names.iter().all(|n| n.trim().is_empty()) {
         bail!("{flag} needs joint names, separated by commas");
     }
-    let bare = |s: &str| s.rsplit(':').next().unwrap_or(s).to_lowercase();
     names
         .iter()
-        .map(|raw| {
-            let name = raw.trim();
-            if name.is_empty() {
-                bail!("{flag}: an empty joint name in '{}'", names.join(","));
-            }
-            if let Some(j) = skeleton.index_of(name) {
-                return Ok(j);
-            }
-            let lower = name.to_lowercase();
-            for key in [|s: &str| s.to_lowercase(), bare] {
-                let hits: Vec<usize> = (0..skeleton.len()).filter(|&j| key(&skeleton.joints[j].name) == key(&lower)).collect();
-                match hits[..] {
-                    [] => {}
-                    [j] => return Ok(j),
-                    _ => {
-                        let all: Vec<&str> = hits.iter().map(|&j| skeleton.joints[j].name.as_str()).collect();
-                        bail!("{flag}: '{name}' could be any of {} in {file}: give the full name", all.join(", "))
-                    }
-                }
-            }
-            bail!("{flag}: {file} has no joint named '{name}' (closest: {})", closest_names(name, skeleton).join(", "))
+        .map(|raw| match lookup::find_joint(skeleton, raw) {
+            Ok(j) => Ok(j),
+            Err(lookup::LookupError::Empty) => bail!("{flag}: an empty joint name in '{}'", names.join(",")),
+            Err(e) => bail!("{flag}: {file}: {e}"),
         })
         .collect()
-}
-
-/// Up to five joint names nearest to `name` (edit distance, ignoring case; also against the
-/// name without its 'namespace:' prefix).
-fn closest_names<'a>(name: &str, skeleton: &'a Skeleton) -> Vec<&'a str> {
-    let want: Vec<char> = name.to_lowercase().chars().collect();
-    let mut scored: Vec<(usize, usize)> = skeleton
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(j, joint)| {
-            let full = joint.name.to_lowercase();
-            let bare = full.rsplit(':').next().unwrap_or(&full);
-            let d = edit_distance(&want, &full.chars().collect::<Vec<_>>()).min(edit_distance(&want, &bare.chars().collect::<Vec<_>>()));
-            (d, j)
-        })
-        .collect();
-    scored.sort_unstable();
-    scored.iter().take(5).map(|&(_, j)| skeleton.joints[j].name.as_str()).collect()
-}
-
-/// Levenshtein distance.
-fn edit_distance(a: &[char], b: &[char]) -> usize {
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.iter().enumerate() {
-        let mut diagonal = row[0];
-        row[0] = i + 1;
-        for (k, cb) in b.iter().enumerate() {
-            let next = (diagonal + usize::from(ca != cb)).min(row[k] + 1).min(row[k + 1] + 1);
-            diagonal = row[k + 1];
-            row[k + 1] = next;
-        }
-    }
-    row[b.len()]
 }
 
 /// One line about a rig, for -v.

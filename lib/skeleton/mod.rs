@@ -6,6 +6,7 @@
 //! joint indices match the frame columns. End Sites stay attached to their joint (they carry no
 //! channels); they matter for drawing and height, not for the graph.
 
+pub mod lookup;
 pub mod names;
 pub mod roles;
 pub mod topology;
