@@ -45,7 +45,7 @@ pub enum BindingError {
     #[error("{file}: the binding binds no joints")]
     Empty { file: String },
     #[error("{file}: pair {pair}: {side} joint: {skeleton}: {error}")]
-    Name { file: String, pair: usize, side: &'static str, skeleton: String, error: lookup::LookupError },
+    Name { file: String, pair: usize, side: &'static str, skeleton: String, error: Box<lookup::LookupError> },
     #[error("{file}: pairs {first} and {second} both bind {side} joint '{joint}'")]
     Duplicate { file: String, first: usize, second: usize, side: &'static str, joint: String },
 }
@@ -81,7 +81,7 @@ impl Binding {
                     pair: i,
                     side,
                     skeleton: skeleton_file.to_string(),
-                    error,
+                    error: Box::new(error),
                 })
             };
             let s = find(source, &pair.source, "source", source_file)?;
