@@ -12,6 +12,7 @@ pub mod camera;
 pub mod font;
 pub mod gif;
 pub mod html;
+pub mod labels;
 pub mod raster;
 pub mod sheet;
 
