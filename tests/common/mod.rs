@@ -20,8 +20,15 @@ pub fn shared_data(test: &str) -> Option<PathBuf> {
 
 /// Every BVH file of the corpus, sorted.
 pub fn corpus_bvh_files(data: &Path) -> Vec<PathBuf> {
+    let out = corpus_bvh_files_in(&data.join("bvh"));
+    assert!(!out.is_empty(), "no BVH files under {}", data.display());
+    out
+}
+
+/// Every BVH file under `dir` (recursively), sorted; empty when there is none.
+pub fn corpus_bvh_files_in(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
-    let mut stack = vec![data.join("bvh")];
+    let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         for e in std::fs::read_dir(&d).unwrap() {
             let p = e.unwrap().path();
@@ -33,7 +40,6 @@ pub fn corpus_bvh_files(data: &Path) -> Vec<PathBuf> {
         }
     }
     out.sort();
-    assert!(!out.is_empty(), "no BVH files under {}", data.display());
     out
 }
 
