@@ -7,6 +7,8 @@
 //! tool read in both. Names are resolved with `skeleton::lookup::find_joint` (exact, case,
 //! namespace, normalised name; never substrings), and a pair order is kept as written.
 
+pub mod auto;
+
 use crate::skeleton::{lookup, Skeleton};
 use serde::{Deserialize, Serialize};
 
