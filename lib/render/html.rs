@@ -1,1 +1,320 @@
-//! (being written)
+//! A self-contained HTML viewer: one file with inline CSS, JS and data that plays tracks in 3D.
+//!
+//! The page needs no network and no server (it works from `file://`): the viewer script
+//! (`viewer.js`, plain canvas 2D with its own perspective projection) and style sheet are
+//! embedded with `include_str!`, and the positions travel inside the page as base64 of one
+//! zlib stream that the browser inflates with `DecompressionStream('deflate')`.
+//!
+//! Positions are quantised to 16 bits per coordinate relative to each track's bounding box
+//! (error at most half a step, 1/131070 of the box along each axis), then predicted from the
+//! previous frame(s) of the same point and axis, so what deflate sees is mostly small residuals
+//! in two byte planes. A 5000-frame, 115-point clip stays well under the 1.5 MB we aim for (see
+//! the tests and the report in `tests/render_html.rs`).
+//!
+//! The page also carries a self test: opened with `#selftest` it draws two frames, counts the
+//! drawn pixels of each and the pixels that differ, and writes the result (and any script
+//! error) as JSON into `<pre id="selftest">`, which the browser test reads with
+//! `chromium --dump-dom`.
+
+use super::{palette, Legend, RenderError, Track};
+use serde_json::{json, Value};
+
+const TEMPLATE: &str = include_str!("viewer.html");
+const CSS: &str = include_str!("viewer.css");
+const JS: &str = include_str!("viewer.js");
+
+/// Quantisation steps per axis: 16 bits across the track's bounding box.
+const LEVELS: f64 = 65535.0;
+
+/// How the page plays.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HtmlOptions {
+    /// The page title (browser tab and heading).
+    pub title: String,
+    /// Initial playback speed (1.0 = the motion's own frame rate).
+    pub speed: f64,
+    /// Draw all tracks in one scene on top of each other instead of side by side.
+    pub overlay: bool,
+    /// Start playing when the page opens.
+    pub autoplay: bool,
+    /// The camera follows the root of the (first) track instead of framing the whole path.
+    pub follow: bool,
+}
+
+impl Default for HtmlOptions {
+    fn default() -> Self {
+        HtmlOptions { title: "motion".to_string(), speed: 1.0, overlay: false, autoplay: true, follow: false }
+    }
+}
+
+/// The viewer page for `tracks`, coloured with `legend` (see [`super::labels`]).
+pub fn render_html(tracks: &[Track], legend: &Legend, opts: &HtmlOptions) -> Result<String, RenderError> {
+    validate(tracks, legend)?;
+    if !opts.speed.is_finite() || opts.speed <= 0.0 {
+        return Err(RenderError::Invalid(format!("speed must be a positive number, got {}", opts.speed)));
+    }
+    let mut raw = Vec::new();
+    let mut metas = Vec::with_capacity(tracks.len());
+    for track in tracks {
+        let encoded = encode_track(track);
+        metas.push(track_meta(track, &encoded, raw.len()));
+        raw.extend_from_slice(&encoded.bytes);
+    }
+    // Level 9: the page is written once and read many times; 3.5 MB compress in well under a second.
+    let packed = miniz_oxide::deflate::compress_to_vec_zlib(&raw, 9);
+    let legend_json: Vec<Value> =
+        legend.labels.iter().enumerate().map(|(i, name)| json!({"name": name, "colour": hex(palette(i))})).collect();
+    let meta = json!({
+        "title": opts.title,
+        "speed": opts.speed,
+        "overlay": opts.overlay,
+        "autoplay": opts.autoplay,
+        "follow": opts.follow,
+        "legend": legend_json,
+        // Overlaid tracks without point labels are told apart by colour.
+        "trackColours": (0..tracks.len()).map(|i| hex(palette(i))).collect::<Vec<_>>(),
+        "dataBytes": raw.len(),
+        "tracks": metas,
+    });
+    let meta = script_json(&meta.to_string());
+    let data = base64(&packed);
+    let title = escape_html(&opts.title);
+    Ok(fill(TEMPLATE, &[("TITLE", &title), ("CSS", CSS), ("META", &meta), ("DATA", &data), ("JS", JS)]))
+}
+
+/// Check everything the page relies on, so the viewer never meets a broken track.
+fn validate(tracks: &[Track], legend: &Legend) -> Result<(), RenderError> {
+    if tracks.is_empty() {
+        return Err(RenderError::Empty("no tracks to show".to_string()));
+    }
+    for t in tracks {
+        let name = &t.title;
+        let n = t.points();
+        if t.frames == 0 {
+            return Err(RenderError::Empty(format!("{name}: no frames to show")));
+        }
+        if n == 0 {
+            return Err(RenderError::Empty(format!("{name}: no points to show")));
+        }
+        if t.names.len() != n || t.end_site.len() != n {
+            return Err(RenderError::Invalid(format!(
+                "{name}: {n} points but {} names and {} end-site flags (one each per point)",
+                t.names.len(),
+                t.end_site.len()
+            )));
+        }
+        if t.positions.len() != t.frames * n {
+            return Err(RenderError::Invalid(format!(
+                "{name}: {} positions, expected {} frames x {n} points = {}",
+                t.positions.len(),
+                t.frames,
+                t.frames * n
+            )));
+        }
+        if let Some((p, q)) = t.parents.iter().enumerate().find_map(|(p, q)| q.filter(|&q| q >= n).map(|q| (p, q))) {
+            return Err(RenderError::Invalid(format!("{name}: point {p} has parent {q}, but there are only {n} points")));
+        }
+        if let Some(&foot) = t.feet.iter().find(|&&f| f >= n) {
+            return Err(RenderError::Invalid(format!("{name}: foot {foot} is not a point (there are {n})")));
+        }
+        if !t.fps.is_finite() || t.fps <= 0.0 {
+            return Err(RenderError::Invalid(format!("{name}: frame rate must be a positive number, got {}", t.fps)));
+        }
+        let labels = legend.labels.len();
+        if let Some(pl) = &t.point_labels {
+            if pl.len() != n {
+                return Err(RenderError::Invalid(format!("{name}: {} point labels for {n} points", pl.len())));
+            }
+            if let Some((p, l)) = pl.iter().enumerate().find_map(|(p, l)| l.filter(|&l| l >= labels).map(|l| (p, l))) {
+                return Err(RenderError::Invalid(format!("{name}: point {p} has label {l}, but the legend has {labels} labels")));
+            }
+        }
+        if let Some(fl) = &t.frame_labels {
+            if fl.len() != t.frames {
+                return Err(RenderError::Invalid(format!("{name}: {} frame labels for {} frames", fl.len(), t.frames)));
+            }
+            if let Some((f, l)) = fl.iter().enumerate().find_map(|(f, l)| l.filter(|&l| l >= labels).map(|l| (f, l))) {
+                return Err(RenderError::Invalid(format!("{name}: frame {f} has label {l}, but the legend has {labels} labels")));
+            }
+        }
+        if let Some(i) = t.positions.iter().position(|p| !p.is_finite()) {
+            let (f, p) = (i / n, i % n);
+            return Err(RenderError::NonFinite(format!(
+                "{name}: frame {f}, point {p} ({}) is not finite: {}",
+                t.names[p], t.positions[i]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// One track's positions, ready for the page.
+struct Encoded {
+    /// Bounding box minimum per axis.
+    min: [f64; 3],
+    /// Size of one quantisation step per axis (0 for a flat axis).
+    step: [f64; 3],
+    /// Prediction order: 1 = previous frame, 2 = linear extrapolation from the two previous.
+    order: u8,
+    /// Zigzagged residuals, series by series (point-major, then axis, then frame): all low
+    /// bytes, then all high bytes.
+    bytes: Vec<u8>,
+}
+
+/// Quantised coordinates, one series per point and axis (frames contiguous), and the box.
+fn quantise(track: &Track) -> (Vec<u16>, [f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &track.positions {
+        for (a, v) in p.to_array().into_iter().enumerate() {
+            lo[a] = lo[a].min(v as f64);
+            hi[a] = hi[a].max(v as f64);
+        }
+    }
+    let step: [f64; 3] = std::array::from_fn(|a| (hi[a] - lo[a]) / LEVELS);
+    let (n, frames) = (track.points(), track.frames);
+    let mut q = vec![0u16; n * 3 * frames];
+    for f in 0..frames {
+        for (p, pos) in track.frame(f).iter().enumerate() {
+            for (a, v) in pos.to_array().into_iter().enumerate() {
+                // Validated finite, so the value is within [0, LEVELS] and the cast exact.
+                let level = if step[a] > 0.0 { ((v as f64 - lo[a]) / step[a]).round().clamp(0.0, LEVELS) } else { 0.0 };
+                q[(p * 3 + a) * frames + f] = level as u16;
+            }
+        }
+    }
+    (q, lo, step)
+}
+
+/// Residuals of one series under a prediction order, in wrapping 16-bit arithmetic (the
+/// page undoes it with the same wrap), zigzagged so small residuals of either sign are small.
+fn residuals(series: &[u16], order: u8, out: &mut Vec<u16>) {
+    for (f, &q) in series.iter().enumerate() {
+        let pred = match (f, order) {
+            (0, _) => 0u16,
+            (1, _) | (_, 1) => series[f - 1],
+            _ => series[f - 1].wrapping_mul(2).wrapping_sub(series[f - 2]),
+        };
+        let e = q.wrapping_sub(pred) as i16;
+        out.push(((e << 1) ^ (e >> 15)) as u16);
+    }
+}
+
+/// Rough cost in bits of a residual stream, to pick the prediction order without compressing twice.
+fn cost(residuals: &[u16]) -> u64 {
+    residuals.iter().map(|&z| u64::from(16 - z.leading_zeros()) + 1).sum()
+}
+
+fn encode_track(track: &Track) -> Encoded {
+    let (q, min, step) = quantise(track);
+    let frames = track.frames;
+    // Order 2 wins for smooth, densely sampled motion; order 1 for noisy or sparse motion.
+    let mut best: Option<(u64, u8, Vec<u16>)> = None;
+    for order in [1u8, 2] {
+        let mut r = Vec::with_capacity(q.len());
+        for series in q.chunks(frames) {
+            residuals(series, order, &mut r);
+        }
+        let c = cost(&r);
+        if best.as_ref().is_none_or(|(bc, _, _)| c < *bc) {
+            best = Some((c, order, r));
+        }
+    }
+    let (_, order, r) = best.expect("two orders tried");
+    let mut bytes = Vec::with_capacity(2 * r.len());
+    bytes.extend(r.iter().map(|z| (z & 0xff) as u8));
+    bytes.extend(r.iter().map(|z| (z >> 8) as u8));
+    Encoded { min, step, order, bytes }
+}
+
+fn track_meta(track: &Track, e: &Encoded, offset: usize) -> Value {
+    json!({
+        "title": track.title,
+        "names": track.names,
+        "parents": track.parents,
+        "endSite": track.end_site,
+        "feet": track.feet,
+        "fps": track.fps,
+        "frames": track.frames,
+        "points": track.points(),
+        "min": e.min,
+        "step": e.step,
+        "order": e.order,
+        "offset": offset,
+        "pointLabels": track.point_labels,
+        "frameLabels": track.frame_labels,
+    })
+}
+
+/// Positions as the page decodes them (for tests: the quantisation error is measured on this).
+pub fn decoded_positions(track: &Track) -> Vec<[f64; 3]> {
+    let (q, min, step) = quantise(track);
+    let (n, frames) = (track.points(), track.frames);
+    (0..frames * n).map(|i| std::array::from_fn(|a| min[a] + f64::from(q[((i % n) * 3 + a) * frames + i / n]) * step[a])).collect()
+}
+
+fn hex([r, g, b]: [u8; 3]) -> String {
+    format!("#{r:02x}{g:02x}{b:02x}")
+}
+
+/// Text for HTML element content and attribute values.
+fn escape_html(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// JSON safe inside `<script type="application/json">`: `<`, `>` and `&` only occur inside JSON
+/// strings, where their \u escapes mean the same, so no `</script>` or `<!--` can end the element.
+fn script_json(json: &str) -> String {
+    json.replace('<', "\\u003c").replace('>', "\\u003e").replace('&', "\\u0026")
+}
+
+/// Replace `{{KEY}}` markers in one pass, so inserted text is never scanned for markers.
+fn fill(template: &str, values: &[(&str, &str)]) -> String {
+    let mut out = String::with_capacity(template.len() + values.iter().map(|(_, v)| v.len()).sum::<usize>());
+    let mut rest = template;
+    while let Some(start) = rest.find("{{") {
+        out.push_str(&rest[..start]);
+        let after = &rest[start + 2..];
+        match after.find("}}").and_then(|end| values.iter().find(|(k, _)| *k == &after[..end]).map(|(_, v)| (end, v))) {
+            Some((end, v)) => {
+                out.push_str(v);
+                rest = &after[end + 2..];
+            }
+            None => {
+                out.push_str("{{");
+                rest = after;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// Standard base64 with padding (the page decodes it with `atob`).
+fn base64(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [chunk[0], chunk.get(1).copied().unwrap_or(0), chunk.get(2).copied().unwrap_or(0)];
+        let v = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for i in 0..4 {
+            if i <= chunk.len() {
+                out.push(ALPHABET[((v >> (18 - 6 * i)) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}

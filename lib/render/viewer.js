@@ -1,0 +1,469 @@
+// menagerie motion viewer: plays tracks in 3D on a 2D canvas with our own perspective projection.
+// Data: #meta (JSON: tracks, legend, options) and #data (base64 of one zlib stream holding each
+// track's quantised positions as zigzagged prediction residuals; see lib/render/html.rs).
+'use strict';
+(function () {
+  const meta = JSON.parse(document.getElementById('meta').textContent);
+  const $ = (id) => document.getElementById(id);
+  const canvas = $('view'), ctx = canvas.getContext('2d');
+  const FOV = 40 * Math.PI / 180;
+  const BACKGROUND = '#fafafa', GRID = '#d8d8d8', BONE = '#333333';
+
+  // ---- data ----------------------------------------------------------------------------------
+
+  async function inflate(text) {
+    const binary = atob(text.trim());
+    const bytes = new Uint8Array(binary.length);
+    for (let i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
+    if (typeof DecompressionStream === 'undefined') {
+      throw new Error('this browser cannot decompress the motion (no DecompressionStream): use a current Chrome, Firefox or Safari');
+    }
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+
+  // Undo html.rs's encoding: series per point and axis, residuals of a prediction from the
+  // previous frame(s), zigzagged, low bytes then high bytes; then 16-bit levels to positions.
+  function decodeTrack(t, bytes) {
+    const F = t.frames, P = t.points, n = F * P * 3;
+    const lo = bytes.subarray(t.offset, t.offset + n), hi = bytes.subarray(t.offset + n, t.offset + 2 * n);
+    const pos = new Float32Array(n);
+    let k = 0;
+    for (let p = 0; p < P; p++) {
+      for (let a = 0; a < 3; a++) {
+        let prev = 0, prev2 = 0;
+        for (let f = 0; f < F; f++, k++) {
+          const z = lo[k] | (hi[k] << 8);
+          const e = (z >>> 1) ^ -(z & 1);
+          const pred = f === 0 ? 0 : (t.order === 2 && f >= 2 ? 2 * prev - prev2 : prev);
+          const q = (pred + e) & 0xffff;
+          pos[(f * P + p) * 3 + a] = t.min[a] + q * t.step[a];
+          prev2 = prev; prev = q;
+        }
+      }
+    }
+    t.pos = pos;
+  }
+
+  // Bounds, ground, body size and path of a set of tracks (one view).
+  function measure(tracks) {
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    let body = 0;
+    for (const t of tracks) {
+      for (let a = 0; a < 3; a++) {
+        lo[a] = Math.min(lo[a], t.min[a]);
+        hi[a] = Math.max(hi[a], t.min[a] + 65535 * t.step[a]);
+      }
+      // Body size: the largest single-frame extent, sampled (a long walk is not a big body).
+      const every = Math.max(1, Math.floor(t.frames / 200));
+      for (let f = 0; f < t.frames; f += every) {
+        const l = [Infinity, Infinity, Infinity], h = [-Infinity, -Infinity, -Infinity];
+        for (let p = 0; p < t.points; p++) {
+          for (let a = 0; a < 3; a++) {
+            const v = t.pos[(f * t.points + p) * 3 + a];
+            if (v < l[a]) l[a] = v;
+            if (v > h[a]) h[a] = v;
+          }
+        }
+        body = Math.max(body, Math.hypot(h[0] - l[0], h[1] - l[1], h[2] - l[2]));
+      }
+    }
+    const size = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    body = body > 0 ? body : (size > 0 ? size : 1);
+    return { lo, hi, body, ground: lo[1], centre: lo.map((v, a) => (v + hi[a]) / 2), radius: Math.max(size, body) / 2 };
+  }
+
+  function root(t, f) {
+    const i = f * t.points * 3;
+    return [t.pos[i], t.pos[i + 1], t.pos[i + 2]];
+  }
+
+  // ---- state ---------------------------------------------------------------------------------
+
+  const tracks = meta.tracks;
+  const views = [];
+  const maxFps = Math.max(...tracks.map((t) => t.fps));
+  const duration = Math.max(...tracks.map((t) => t.frames / t.fps));
+  const steps = Math.max(1, Math.round(duration * maxFps));
+  const cam = { yaw: 0.5, pitch: 0.3, zoom: 1, panX: 0, panY: 0 };
+  let defaultYaw = 0.5;
+  let time = 0, playing = meta.autoplay, speed = meta.speed, follow = meta.follow, dirty = true;
+  let hovered = null, projected = [];
+
+  function frameOf(t, time) {
+    return Math.max(0, Math.min(t.frames - 1, Math.floor(time * t.fps + 1e-6)));
+  }
+
+  function labelColour(index) {
+    return index === null || index === undefined || !meta.legend[index] ? null : meta.legend[index].colour;
+  }
+
+  // ---- camera and projection -----------------------------------------------------------------
+
+  // A camera for one view rectangle: orbit about the view's target at a distance that fits the
+  // view's radius (its whole path, or its body when following), whatever the creature's size.
+  function camera(view, rect) {
+    const m = view.m;
+    let target = m.centre.slice(), radius = m.radius;
+    if (follow) {
+      const r = root(view.tracks[0], frameOf(view.tracks[0], time));
+      target = [r[0], m.ground + m.body / 3, r[2]];
+      radius = m.body * 0.6;
+    }
+    const aspect = rect.w / rect.h;
+    const dist = (radius * 1.15) / (Math.tan(FOV / 2) * Math.min(1, aspect)) / cam.zoom;
+    const cp = Math.cos(cam.pitch), sp = Math.sin(cam.pitch), cy = Math.cos(cam.yaw), sy = Math.sin(cam.yaw);
+    const back = [cp * sy, sp, cp * cy];                 // from target towards the eye
+    const right = [cy, 0, -sy];
+    const up = [-sp * sy, cp, -sp * cy];                 // back x right
+    // Pan moves the target in the screen plane, in units of the fitted radius.
+    for (let a = 0; a < 3; a++) target[a] += (cam.panX * right[a] + cam.panY * up[a]) * radius;
+    const eye = target.map((v, a) => v + back[a] * dist);
+    const focal = (rect.h / 2) / Math.tan(FOV / 2);
+    const near = dist * 0.02;
+    return {
+      rect, dist, near,
+      project(x, y, z) {
+        const d = [x - eye[0], y - eye[1], z - eye[2]];
+        const depth = -(d[0] * back[0] + d[1] * back[1] + d[2] * back[2]);
+        if (depth < near) return null;
+        const sx = d[0] * right[0] + d[2] * right[2];
+        const sy2 = d[0] * up[0] + d[1] * up[1] + d[2] * up[2];
+        return [rect.x + rect.w / 2 + (sx * focal) / depth, rect.y + rect.h / 2 - (sy2 * focal) / depth, depth];
+      },
+    };
+  }
+
+  // A round grid step (1, 2 or 5 times a power of ten) near a quarter of the body size.
+  function gridStep(body) {
+    const raw = body / 4, p = Math.pow(10, Math.floor(Math.log10(raw)));
+    const m = raw / p;
+    return (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10) * p;
+  }
+
+  // ---- drawing -------------------------------------------------------------------------------
+
+  function line(a, b) {
+    if (!a || !b) return;
+    ctx.beginPath();
+    ctx.moveTo(a[0], a[1]);
+    ctx.lineTo(b[0], b[1]);
+    ctx.stroke();
+  }
+
+  function drawGrid(view, c) {
+    const m = view.m;
+    let step = gridStep(m.body);
+    const margin = m.body;
+    let x0 = m.lo[0] - margin, x1 = m.hi[0] + margin, z0 = m.lo[2] - margin, z1 = m.hi[2] + margin;
+    // Long paths: coarser lines rather than thousands of them.
+    while ((x1 - x0) / step + (z1 - z0) / step > 400) step *= 2;
+    x0 = Math.floor(x0 / step) * step; x1 = Math.ceil(x1 / step) * step;
+    z0 = Math.floor(z0 / step) * step; z1 = Math.ceil(z1 / step) * step;
+    const y = m.ground;
+    ctx.strokeStyle = GRID;
+    ctx.lineWidth = 1;
+    // Lines are cut into pieces so perspective clipping at the near plane only drops short bits.
+    const pieces = 8;
+    for (let x = x0; x <= x1 + step / 2; x += step) {
+      for (let i = 0; i < pieces; i++) {
+        line(c.project(x, y, z0 + ((z1 - z0) * i) / pieces), c.project(x, y, z0 + ((z1 - z0) * (i + 1)) / pieces));
+      }
+    }
+    for (let z = z0; z <= z1 + step / 2; z += step) {
+      for (let i = 0; i < pieces; i++) {
+        line(c.project(x0 + ((x1 - x0) * i) / pieces, y, z), c.project(x0 + ((x1 - x0) * (i + 1)) / pieces, y, z));
+      }
+    }
+  }
+
+  function drawTrack(view, c, t, k) {
+    const f = frameOf(t, time);
+    const pts = [];
+    for (let p = 0; p < t.points; p++) {
+      const i = (f * t.points + p) * 3;
+      pts.push(c.project(t.pos[i], t.pos[i + 1], t.pos[i + 2]));
+    }
+    const plain = meta.overlay && tracks.length > 1 ? meta.trackColours[t.index] : BONE;
+    const colour = (p) => (t.pointLabels && labelColour(t.pointLabels[p])) || plain;
+    // Overlaid tracks after the first are dashed, so they stay apart even in label colours.
+    ctx.setLineDash(meta.overlay && k > 0 ? [6, 4] : []);
+    ctx.lineWidth = 2.5;
+    ctx.lineCap = 'round';
+    for (let p = 0; p < t.points; p++) {
+      const q = t.parents[p];
+      if (q === null) continue;
+      ctx.strokeStyle = colour(p);
+      line(pts[q], pts[p]);
+    }
+    ctx.setLineDash([]);
+    const feet = new Set(t.feet);
+    for (let p = 0; p < t.points; p++) {
+      const s = pts[p];
+      if (!s || t.endSite[p]) continue;
+      projected.push({ x: s[0], y: s[1], name: t.names[p], track: t, frame: f });
+      ctx.fillStyle = colour(p);
+      if (feet.has(p)) {
+        ctx.strokeStyle = colour(p);
+        ctx.lineWidth = 2;
+        ctx.strokeRect(s[0] - 4.5, s[1] - 4.5, 9, 9);
+      } else {
+        ctx.beginPath();
+        ctx.arc(s[0], s[1], 3, 0, 2 * Math.PI);
+        ctx.fill();
+      }
+    }
+  }
+
+  function drawView(view) {
+    const r = view.rect, c = camera(view, r);
+    ctx.save();
+    ctx.beginPath();
+    ctx.rect(r.x, r.y, r.w, r.h);
+    ctx.clip();
+    // Frame labels tint the view (the first track's label, which is also written in the corner).
+    const first = view.tracks[0];
+    const label = first.frameLabels ? first.frameLabels[frameOf(first, time)] : null;
+    const tint = labelColour(label);
+    if (tint) {
+      ctx.globalAlpha = 0.12;
+      ctx.fillStyle = tint;
+      ctx.fillRect(r.x, r.y, r.w, r.h);
+      ctx.globalAlpha = 1;
+    }
+    drawGrid(view, c);
+    view.tracks.forEach((t, k) => drawTrack(view, c, t, k));
+    ctx.fillStyle = '#222';
+    ctx.font = '13px system-ui, sans-serif';
+    let y = r.y + 18;
+    for (const t of view.tracks) {
+      const f = frameOf(t, time);
+      const li = t.frameLabels ? t.frameLabels[f] : null;
+      const l = li !== null && meta.legend[li] ? meta.legend[li].name : null;
+      ctx.fillText(`${t.title}  frame ${f + 1}/${t.frames}  ${+t.fps.toFixed(2)} fps${l ? '  · ' + l : ''}`, r.x + 8, y);
+      y += 17;
+    }
+    ctx.restore();
+    if (r.x > 0) {
+      ctx.strokeStyle = '#ccc';
+      ctx.lineWidth = 1;
+      line([r.x + 0.5, r.y], [r.x + 0.5, r.y + r.h]);
+    }
+  }
+
+  function draw() {
+    const dpr = window.devicePixelRatio || 1;
+    const w = Math.max(1, canvas.clientWidth), h = Math.max(1, canvas.clientHeight);
+    if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+      canvas.width = Math.round(w * dpr);
+      canvas.height = Math.round(h * dpr);
+    }
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    ctx.fillStyle = BACKGROUND;
+    ctx.fillRect(0, 0, w, h);
+    projected = [];
+    views.forEach((v, i) => {
+      const vw = w / views.length;
+      v.rect = { x: i * vw, y: 0, w: vw, h };
+      drawView(v);
+    });
+    if (hovered) {
+      ctx.strokeStyle = '#d00';
+      ctx.lineWidth = 2;
+      ctx.beginPath();
+      ctx.arc(hovered.x, hovered.y, 7, 0, 2 * Math.PI);
+      ctx.stroke();
+    }
+    const slider = $('slider');
+    if (document.activeElement !== slider || playing) slider.value = Math.min(steps - 1, Math.floor(time * maxFps + 1e-6));
+    $('clock').textContent = `${time.toFixed(2)} s`;
+    $('play').textContent = playing ? 'Pause' : 'Play';
+    dirty = false;
+  }
+
+  // ---- controls ------------------------------------------------------------------------------
+
+  function setPlaying(p) { playing = p; dirty = true; }
+  function stepBy(n) { setPlaying(false); time = Math.max(0, Math.min(duration - 1e-9, (Math.floor(time * maxFps + 1e-6) + n) / maxFps)); }
+  function resetCamera() { Object.assign(cam, { yaw: defaultYaw, pitch: 0.3, zoom: 1, panX: 0, panY: 0 }); dirty = true; }
+
+  function setupControls() {
+    $('play').addEventListener('click', () => setPlaying(!playing));
+    const slider = $('slider');
+    slider.max = String(steps - 1);
+    slider.addEventListener('input', () => { time = Number(slider.value) / maxFps; dirty = true; });
+    const select = $('speed');
+    const speeds = [0.1, 0.25, 0.5, 1, 2, 4];
+    if (!speeds.includes(speed)) speeds.push(speed);
+    speeds.sort((a, b) => a - b);
+    for (const s of speeds) {
+      const o = document.createElement('option');
+      o.value = String(s);
+      o.textContent = `${s}×`;
+      o.selected = s === speed;
+      select.appendChild(o);
+    }
+    select.addEventListener('change', () => { speed = Number(select.value); });
+    const followBox = $('follow');
+    followBox.checked = follow;
+    followBox.addEventListener('change', () => { follow = followBox.checked; cam.panX = cam.panY = 0; dirty = true; });
+    $('reset').addEventListener('click', resetCamera);
+    window.addEventListener('keydown', (e) => {
+      if (e.target instanceof HTMLInputElement && e.target.type !== 'range' && e.target.type !== 'checkbox') return;
+      if (e.key === ' ') { setPlaying(!playing); e.preventDefault(); }
+      else if (e.key === 'ArrowRight') { stepBy(1); e.preventDefault(); }
+      else if (e.key === 'ArrowLeft') { stepBy(-1); e.preventDefault(); }
+      else if (e.key === 'Home') { time = 0; dirty = true; }
+      else if (e.key === 'f') { followBox.checked = follow = !follow; dirty = true; }
+      else if (e.key === 'r') resetCamera();
+    });
+    window.addEventListener('resize', () => { dirty = true; });
+
+    let drag = null;
+    canvas.addEventListener('pointerdown', (e) => {
+      drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey || e.button === 2 };
+      canvas.setPointerCapture(e.pointerId);
+      canvas.classList.add('dragging');
+    });
+    canvas.addEventListener('pointerup', (e) => { drag = null; canvas.releasePointerCapture(e.pointerId); canvas.classList.remove('dragging'); });
+    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+    canvas.addEventListener('pointermove', (e) => {
+      const box = canvas.getBoundingClientRect();
+      if (drag) {
+        const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+        drag.x = e.clientX; drag.y = e.clientY;
+        if (drag.pan) {
+          const scale = 2 / (box.height * cam.zoom);
+          cam.panX -= dx * scale;
+          cam.panY += dy * scale;
+        } else {
+          cam.yaw -= dx * 0.01;
+          cam.pitch = Math.max(-1.45, Math.min(1.45, cam.pitch + dy * 0.01));
+        }
+        hideTip();
+        dirty = true;
+        return;
+      }
+      hover(e.clientX - box.left, e.clientY - box.top);
+    });
+    canvas.addEventListener('pointerleave', hideTip);
+    canvas.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      cam.zoom = Math.max(0.05, Math.min(50, cam.zoom * Math.exp(-e.deltaY * 0.0015)));
+      dirty = true;
+    }, { passive: false });
+  }
+
+  function hideTip() {
+    $('tip').hidden = true;
+    if (hovered) { hovered = null; dirty = true; }
+  }
+
+  // The joint nearest the pointer (within 10 px) gets a tooltip with its name and track.
+  function hover(x, y) {
+    let best = null, bestD = 100;
+    for (const p of projected) {
+      const d = (p.x - x) ** 2 + (p.y - y) ** 2;
+      if (d < bestD) { bestD = d; best = p; }
+    }
+    if (!best) { hideTip(); return; }
+    const tip = $('tip');
+    tip.textContent = `${best.name}\n${best.track.title} · frame ${best.frame + 1}`;
+    tip.hidden = false;
+    tip.style.left = `${x + 14}px`;
+    tip.style.top = `${y + 10}px`;
+    if (!hovered || hovered.name !== best.name || hovered.track !== best.track) dirty = true;
+    hovered = best;
+  }
+
+  function setupLegend() {
+    const box = $('legend');
+    const rows = meta.legend.map((l) => [l.colour, l.name]);
+    // Overlaid tracks without labels are told apart by colour: list them instead.
+    if (meta.overlay && tracks.length > 1 && !tracks.some((t) => t.pointLabels)) {
+      tracks.forEach((t, i) => rows.push([meta.trackColours[i], t.title + (i > 0 ? ' (dashed)' : '')]));
+    }
+    for (const [colour, name] of rows) {
+      const row = document.createElement('div');
+      const swatch = document.createElement('i');
+      swatch.style.background = colour;
+      const text = document.createElement('span');
+      text.textContent = name;
+      row.append(swatch, text);
+      box.appendChild(row);
+    }
+    box.hidden = rows.length === 0;
+  }
+
+  // ---- playback: fps-correct by accumulating real elapsed time, not counting animation frames --
+
+  let last = null;
+  function tick(now) {
+    if (last !== null && playing) {
+      time += (Math.min(now - last, 250) / 1000) * speed;
+      if (time >= duration) time %= duration;
+      dirty = true;
+    }
+    last = now;
+    if (dirty) draw();
+    requestAnimationFrame(tick);
+  }
+
+  // ---- self test: two frames drawn, pixels counted, result as JSON for the browser test ---------
+
+  function selftest() {
+    const w = canvas.width, h = canvas.height;
+    const shot = (t) => {
+      time = t;
+      draw();
+      return ctx.getImageData(0, 0, w, h).data;
+    };
+    const bg = [0xfa, 0xfa, 0xfa];
+    const a = shot(0), b = shot(duration / 2);
+    let inkA = 0, inkB = 0, diff = 0;
+    for (let i = 0; i < a.length; i += 4) {
+      if (Math.abs(a[i] - bg[0]) + Math.abs(a[i + 1] - bg[1]) + Math.abs(a[i + 2] - bg[2]) > 30) inkA++;
+      if (Math.abs(b[i] - bg[0]) + Math.abs(b[i + 1] - bg[1]) + Math.abs(b[i + 2] - bg[2]) > 30) inkB++;
+      if (a[i] !== b[i] || a[i + 1] !== b[i + 1] || a[i + 2] !== b[i + 2]) diff++;
+    }
+    return {
+      width: w, height: h, tracks: tracks.length, views: views.length,
+      frames: tracks.map((t) => [frameOf(t, 0), frameOf(t, duration / 2)]),
+      ink: [inkA, inkB], diff,
+    };
+  }
+
+  function report(result) {
+    const pre = $('selftest');
+    pre.textContent = JSON.stringify(Object.assign(result, { errors: window.viewerErrors }));
+  }
+
+  async function main() {
+    const bytes = await inflate(document.getElementById('data').textContent);
+    if (bytes.length !== meta.dataBytes) throw new Error(`motion data is ${bytes.length} bytes, expected ${meta.dataBytes}`);
+    tracks.forEach((t, i) => { t.index = i; decodeTrack(t, bytes); });
+    if (meta.overlay) views.push({ tracks, m: measure(tracks) });
+    else for (const t of tracks) views.push({ tracks: [t], m: measure([t]) });
+    // Walks go left to right: look at the first track's path from its side.
+    const t0 = tracks[0], a = root(t0, 0), b = root(t0, t0.frames - 1);
+    const dx = b[0] - a[0], dz = b[2] - a[2];
+    if (Math.hypot(dx, dz) > 0.3 * views[0].m.body) defaultYaw = Math.atan2(-dz, dx);
+    resetCamera();
+    setupControls();
+    setupLegend();
+    if (location.hash === '#selftest') {
+      playing = false;
+      report(selftest());
+      return;
+    }
+    requestAnimationFrame(tick);
+  }
+
+  main().catch((e) => {
+    const m = $('message');
+    m.textContent = `cannot show the motion: ${e && e.message ? e.message : e}`;
+    m.hidden = false;
+    console.error(m.textContent);
+    if (location.hash === '#selftest') report({ failed: true });
+  });
+})();
