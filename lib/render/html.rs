@@ -5,11 +5,12 @@
 //! embedded with `include_str!`, and the positions travel inside the page as base64 of one
 //! zlib stream that the browser inflates with `DecompressionStream('deflate')`.
 //!
-//! Positions are quantised to 16 bits per coordinate relative to each track's bounding box
-//! (error at most half a step, 1/131070 of the box along each axis), then predicted from the
-//! previous frame(s) of the same point and axis, so what deflate sees is mostly small residuals
-//! in two byte planes. A 5000-frame, 115-point clip stays well under the 1.5 MB we aim for (see
-//! the tests and the report in `tests/render_html.rs`).
+//! Positions are quantised to 16-bit levels of 1/2000 of the creature's size (error at most
+//! 0.025% of the body per coordinate; see `quantise`), stored relative to the parent point,
+//! and predicted from the previous frame(s) of the same series, so what deflate sees is mostly
+//! small residuals in two byte planes. Real 30 fps mocap takes about 1-1.4 bytes per point and
+//! frame after base64, so a 5000-frame, 115-point clip makes a page of 0.7-1.0 MB
+//! (`cargo test --test render_html -- --ignored --nocapture` measures it on the corpus).
 //!
 //! The page also carries a self test: opened with `#selftest` it draws two frames, counts the
 //! drawn pixels of each and the pixels that differ, and writes the result (and any script
@@ -23,8 +24,12 @@ const TEMPLATE: &str = include_str!("viewer.html");
 const CSS: &str = include_str!("viewer.css");
 const JS: &str = include_str!("viewer.js");
 
-/// Quantisation steps per axis: 16 bits across the track's bounding box.
+/// Highest 16-bit level.
 const LEVELS: f64 = 65535.0;
+/// Levels per body size (see `quantise`).
+const BODY_LEVELS: f64 = 2000.0;
+/// Decoded positions per track that the page's self test checks its decoder against.
+const PROBES: usize = 16;
 
 /// How the page plays.
 #[derive(Clone, Debug, PartialEq)]
@@ -150,40 +155,74 @@ fn validate(tracks: &[Track], legend: &Legend) -> Result<(), RenderError> {
 
 /// One track's positions, ready for the page.
 struct Encoded {
-    /// Bounding box minimum per axis.
-    min: [f64; 3],
-    /// Size of one quantisation step per axis (0 for a flat axis).
-    step: [f64; 3],
+    q: Quantised,
     /// Prediction order: 1 = previous frame, 2 = linear extrapolation from the two previous.
     order: u8,
     /// Zigzagged residuals, series by series (point-major, then axis, then frame): all low
-    /// bytes, then all high bytes.
+    /// bytes, then all high bytes (the high bytes are mostly 0 and compress to almost nothing).
     bytes: Vec<u8>,
 }
 
-/// Quantised coordinates, one series per point and axis (frames contiguous), and the box.
-fn quantise(track: &Track) -> (Vec<u16>, [f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
+/// 16-bit levels of every coordinate: `min + level * step` is the position the page shows.
+struct Quantised {
+    /// One series per point and axis, frames contiguous: level of point `p`, axis `a`, frame
+    /// `f` at `[(p * 3 + a) * frames + f]`.
+    levels: Vec<u16>,
+    min: [f64; 3],
+    /// Size of one level per axis (0 for a flat axis).
+    step: [f64; 3],
+}
+
+/// The largest single-frame extent (bounding box diagonal): the creature's size, whatever
+/// distance it travels.
+fn body_size(track: &Track) -> f64 {
+    (0..track.frames)
+        .map(|f| {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for p in track.frame(f) {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(f64::from(p[a]));
+                    hi[a] = hi[a].max(f64::from(p[a]));
+                }
+            }
+            (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Quantise relative to the creature's size: a level is 1/2000 of the body, so a coordinate
+/// is off by at most 0.025% of the body (a point by at most 0.043%), far below a pixel, while
+/// finer levels would only add bits deflate cannot remove (the motion's own noise). Paths
+/// longer than 32 bodies take coarser levels so 16 bits still span the bounding box.
+fn quantise(track: &Track) -> Quantised {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in &track.positions {
-        for (a, v) in p.to_array().into_iter().enumerate() {
-            lo[a] = lo[a].min(v as f64);
-            hi[a] = hi[a].max(v as f64);
+        for a in 0..3 {
+            lo[a] = lo[a].min(f64::from(p[a]));
+            hi[a] = hi[a].max(f64::from(p[a]));
         }
     }
-    let step: [f64; 3] = std::array::from_fn(|a| (hi[a] - lo[a]) / LEVELS);
+    let body = body_size(track);
+    let step: [f64; 3] = std::array::from_fn(|a| (body / BODY_LEVELS).max((hi[a] - lo[a]) / LEVELS));
     let (n, frames) = (track.points(), track.frames);
-    let mut q = vec![0u16; n * 3 * frames];
+    let mut levels = vec![0u16; n * 3 * frames];
     for f in 0..frames {
         for (p, pos) in track.frame(f).iter().enumerate() {
-            for (a, v) in pos.to_array().into_iter().enumerate() {
-                // Validated finite, so the value is within [0, LEVELS] and the cast exact.
-                let level = if step[a] > 0.0 { ((v as f64 - lo[a]) / step[a]).round().clamp(0.0, LEVELS) } else { 0.0 };
-                q[(p * 3 + a) * frames + f] = level as u16;
+            for a in 0..3 {
+                // Validated finite, and the step spans the box, so the cast is exact.
+                let level = if step[a] > 0.0 { ((f64::from(pos[a]) - lo[a]) / step[a]).round().clamp(0.0, LEVELS) } else { 0.0 };
+                levels[(p * 3 + a) * frames + f] = level as u16;
             }
         }
     }
-    (q, lo, step)
+    Quantised { levels, min: lo, step }
+}
+
+/// The point a point's levels are stored relative to: its parent, when the page decodes that
+/// first (a lower index; true of every track `Track::from_motion` builds). A child moves with
+/// its parent, so the difference changes more slowly than either.
+fn reference(track: &Track, p: usize) -> Option<usize> {
+    track.parents[p].filter(|&q| q < p)
 }
 
 /// Residuals of one series under a prediction order, in wrapping 16-bit arithmetic (the
@@ -206,14 +245,22 @@ fn cost(residuals: &[u16]) -> u64 {
 }
 
 fn encode_track(track: &Track) -> Encoded {
-    let (q, min, step) = quantise(track);
+    let q = quantise(track);
     let frames = track.frames;
+    let series = |i: usize| &q.levels[i * frames..(i + 1) * frames];
+    let relative: Vec<u16> = (0..track.points() * 3)
+        .flat_map(|i| {
+            let (p, a) = (i / 3, i % 3);
+            let base = reference(track, p).map(|r| series(r * 3 + a));
+            series(i).iter().enumerate().map(move |(f, &v)| base.map_or(v, |b| v.wrapping_sub(b[f])))
+        })
+        .collect();
     // Order 2 wins for smooth, densely sampled motion; order 1 for noisy or sparse motion.
     let mut best: Option<(u64, u8, Vec<u16>)> = None;
     for order in [1u8, 2] {
-        let mut r = Vec::with_capacity(q.len());
-        for series in q.chunks(frames) {
-            residuals(series, order, &mut r);
+        let mut r = Vec::with_capacity(relative.len());
+        for s in relative.chunks(frames) {
+            residuals(s, order, &mut r);
         }
         let c = cost(&r);
         if best.as_ref().is_none_or(|(bc, _, _)| c < *bc) {
@@ -224,33 +271,49 @@ fn encode_track(track: &Track) -> Encoded {
     let mut bytes = Vec::with_capacity(2 * r.len());
     bytes.extend(r.iter().map(|z| (z & 0xff) as u8));
     bytes.extend(r.iter().map(|z| (z >> 8) as u8));
-    Encoded { min, step, order, bytes }
+    Encoded { q, order, bytes }
+}
+
+/// Position of point `p` at frame `f` as the page decodes it.
+fn dequantised(track: &Track, q: &Quantised, f: usize, p: usize) -> [f64; 3] {
+    std::array::from_fn(|a| q.min[a] + f64::from(q.levels[(p * 3 + a) * track.frames + f]) * q.step[a])
 }
 
 fn track_meta(track: &Track, e: &Encoded, offset: usize) -> Value {
+    let (n, frames) = (track.points(), track.frames);
+    // A few decoded positions, spread over frames and points, that the page's self test
+    // compares its own decoding with (the JS decoder is checked against this one).
+    let probes: Vec<Value> = (0..PROBES)
+        .map(|i| {
+            let (f, p) = ((i * frames) / PROBES, (i * 7919 + n - 1) % n);
+            json!([f, p, dequantised(track, &e.q, f, p)])
+        })
+        .collect();
     json!({
         "title": track.title,
         "names": track.names,
         "parents": track.parents,
+        "reference": (0..n).map(|p| reference(track, p)).collect::<Vec<_>>(),
         "endSite": track.end_site,
         "feet": track.feet,
         "fps": track.fps,
-        "frames": track.frames,
-        "points": track.points(),
-        "min": e.min,
-        "step": e.step,
+        "frames": frames,
+        "points": n,
+        "min": e.q.min,
+        "step": e.q.step,
         "order": e.order,
         "offset": offset,
         "pointLabels": track.point_labels,
         "frameLabels": track.frame_labels,
+        "probes": probes,
     })
 }
 
-/// Positions as the page decodes them (for tests: the quantisation error is measured on this).
+/// Positions as the page shows them, `[f * points + p]` (the quantisation error is measured on these).
 pub fn decoded_positions(track: &Track) -> Vec<[f64; 3]> {
-    let (q, min, step) = quantise(track);
-    let (n, frames) = (track.points(), track.frames);
-    (0..frames * n).map(|i| std::array::from_fn(|a| min[a] + f64::from(q[((i % n) * 3 + a) * frames + i / n]) * step[a])).collect()
+    let q = quantise(track);
+    let n = track.points();
+    (0..track.frames * n).map(|i| dequantised(track, &q, i / n, i % n)).collect()
 }
 
 fn hex([r, g, b]: [u8; 3]) -> String {
