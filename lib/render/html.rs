@@ -381,3 +381,233 @@ fn base64(bytes: &[u8]) -> String {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::SplitMix64;
+    use glam::Vec3;
+
+    /// A creature-like track: `points` points hanging off a root that walks a circle, each
+    /// swinging at its own frequencies, plus mocap-like jitter (±0.5 mm on a 1.8 m body).
+    fn synthetic(frames: usize, points: usize, seed: u64) -> Track {
+        let mut rng = SplitMix64::new(seed);
+        let parents: Vec<Option<usize>> = (0..points).map(|p| if p == 0 { None } else { Some((p - 1) / 3) }).collect();
+        let swing: Vec<[f64; 6]> = (0..points).map(|_| std::array::from_fn(|i| if i < 3 { rng.range(0.02, 0.15) } else { rng.range(0.4, 1.6) })).collect();
+        let rest: Vec<[f64; 3]> = (0..points).map(|_| [rng.range(-0.4, 0.4), rng.range(0.0, 1.8), rng.range(-0.3, 0.3)]).collect();
+        let fps = 30.0;
+        let mut positions = Vec::with_capacity(frames * points);
+        for f in 0..frames {
+            let t = f as f64 / fps;
+            let (cx, cz) = (3.0 * (t * 0.4).cos(), 3.0 * (t * 0.4).sin());
+            for p in 0..points {
+                let v: [f64; 3] = std::array::from_fn(|a| {
+                    let centre = [cx, 0.0, cz][a];
+                    centre + rest[p][a] + swing[p][a] * (swing[p][a + 3] * std::f64::consts::TAU * t + p as f64).sin() + rng.range(-5e-4, 5e-4)
+                });
+                positions.push(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32));
+            }
+        }
+        Track {
+            title: format!("synthetic {points}"),
+            names: (0..points).map(|p| format!("joint{p}")).collect(),
+            parents,
+            end_site: (0..points).map(|p| p > 0 && p + 5 >= points).collect(),
+            feet: vec![1, 2],
+            fps,
+            frames,
+            positions,
+            point_labels: None,
+            frame_labels: None,
+        }
+    }
+
+    /// The page's own decoding, step by step as viewer.js does it.
+    fn decode_page(page: &str) -> (Value, Vec<Vec<[f64; 3]>>) {
+        let between = |from: &str| {
+            let s = page.find(from).expect(from) + from.len();
+            &page[s..s + page[s..].find("</script>").expect("closing script")]
+        };
+        let meta: Value = serde_json::from_str(between(r#"<script type="application/json" id="meta">"#)).unwrap();
+        let text = between(r#"<script type="application/octet-stream" id="data">"#);
+        let packed = unbase64(text);
+        let bytes = miniz_oxide::inflate::decompress_to_vec_zlib(&packed).unwrap();
+        assert_eq!(bytes.len() as u64, meta["dataBytes"].as_u64().unwrap());
+        let mut out = Vec::new();
+        for t in meta["tracks"].as_array().unwrap() {
+            let u = |k: &str| t[k].as_u64().unwrap() as usize;
+            let (frames, points, offset, order) = (u("frames"), u("points"), u("offset"), u("order"));
+            let min: Vec<f64> = t["min"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+            let step: Vec<f64> = t["step"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+            let n = frames * points * 3;
+            let mut levels = vec![0u16; n];
+            let mut pos = vec![[0.0; 3]; frames * points];
+            for k in 0..n {
+                let (series, f) = (k / frames, k % frames);
+                let (p, a) = (series / 3, series % 3);
+                let z = u16::from(bytes[offset + k]) | (u16::from(bytes[offset + n + k]) << 8);
+                let e = ((z >> 1) as i16) ^ -((z & 1) as i16);
+                let prev = |d: usize| {
+                    // Undo the reference to recover the stored (relative) series value.
+                    let r = t["reference"][p].as_u64().map(|r| levels[(r as usize * 3 + a) * frames + f - d]).unwrap_or(0);
+                    levels[k - d].wrapping_sub(r)
+                };
+                let pred = match f {
+                    0 => 0,
+                    1 => prev(1),
+                    _ if order == 1 => prev(1),
+                    _ => prev(1).wrapping_mul(2).wrapping_sub(prev(2)),
+                };
+                let v = pred.wrapping_add(e as u16);
+                let r = t["reference"][p].as_u64().map(|r| levels[(r as usize * 3 + a) * frames + f]).unwrap_or(0);
+                levels[k] = v.wrapping_add(r);
+                pos[f * points + p][a] = min[a] + f64::from(levels[k]) * step[a];
+            }
+            out.push(pos);
+        }
+        (meta, out)
+    }
+
+    fn unbase64(text: &str) -> Vec<u8> {
+        let value = |c: u8| match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("not base64: {c}"),
+        };
+        let mut out = Vec::new();
+        for chunk in text.trim().as_bytes().chunks(4) {
+            let digits: Vec<u8> = chunk.iter().filter(|&&c| c != b'=').map(|&c| value(c)).collect();
+            let v = digits.iter().enumerate().fold(0u32, |v, (i, &d)| v | (u32::from(d) << (18 - 6 * i)));
+            for i in 0..digits.len().saturating_sub(1) {
+                out.push((v >> (16 - 8 * i)) as u8);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn positions_survive_the_page_within_the_error_bound() {
+        let a = synthetic(120, 23, 1);
+        let mut b = synthetic(7, 4, 2);
+        // Nothing moves and the box is a point: zero-sized steps must decode to the point itself.
+        b.positions.iter_mut().for_each(|p| *p = Vec3::new(1.0, 2.0, 3.0));
+        let tracks = [a, b];
+        let page = render_html(&tracks, &Legend::default(), &HtmlOptions::default()).unwrap();
+        let (meta, decoded) = decode_page(&page);
+        for (t, d) in tracks.iter().zip(&decoded) {
+            let body = body_size(t);
+            let mut worst: f64 = 0.0;
+            for (p, q) in t.positions.iter().zip(d) {
+                worst = worst.max((0..3).map(|a| (f64::from(p[a]) - q[a]).powi(2)).sum::<f64>().sqrt());
+            }
+            assert!(worst <= 0.0005 * body, "{}: error {worst} for body {body}", t.title);
+            assert_eq!(d, &decoded_positions(t), "{}: the page decodes what decoded_positions says", t.title);
+        }
+        assert_eq!(meta["tracks"][1]["points"], 4);
+        assert!(decoded[1].iter().all(|p| *p == [1.0, 2.0, 3.0]));
+    }
+
+    #[test]
+    fn a_long_clip_makes_a_small_page() {
+        // 5000 frames x 115 points: 1.7 M coordinates, 6.9 MB as f32.
+        let track = synthetic(5000, 115, 7);
+        let page = render_html(std::slice::from_ref(&track), &Legend::default(), &HtmlOptions::default()).unwrap();
+        eprintln!("5000 x 115 synthetic: page {} bytes", page.len());
+        assert!(page.len() < 1_500_000, "page is {} bytes", page.len());
+        let body = body_size(&track);
+        let worst = track
+            .positions
+            .iter()
+            .zip(decoded_positions(&track))
+            .map(|(p, q)| (0..3).map(|a| (f64::from(p[a]) - q[a]).powi(2)).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.0005 * body, "error {worst} for body {body}");
+    }
+
+    #[test]
+    fn hostile_names_stay_text() {
+        let mut t = synthetic(5, 4, 3);
+        t.title = "</script><script>alert(1)</script>".to_string();
+        t.names[2] = "<!-- \"quoted\" & 'single' </SCRIPT >".to_string();
+        t.point_labels = Some(vec![Some(0), None, Some(1), Some(0)]);
+        let legend = Legend { labels: vec!["</style>".to_string(), "a\u{2028}b <b>".to_string()] };
+        let opts = HtmlOptions { title: "</title><script>alert(2)</script>&".to_string(), ..HtmlOptions::default() };
+        let page = render_html(std::slice::from_ref(&t), &legend, &opts).unwrap();
+        let lower = page.to_ascii_lowercase();
+        // Only the template's own four scripts, one title, one style and no comment opener.
+        assert_eq!(lower.matches("<script").count(), 4, "{page}");
+        assert_eq!(lower.matches("</script").count(), 4);
+        assert_eq!(lower.matches("</title").count(), 1);
+        assert_eq!(lower.matches("</style").count(), 1);
+        assert!(!page.contains("<!--"));
+        assert!(page.contains("<title>&lt;/title&gt;&lt;script&gt;alert(2)&lt;/script&gt;&amp;</title>"));
+        let (meta, _) = decode_page(&page);
+        assert_eq!(meta["tracks"][0]["title"], t.title);
+        assert_eq!(meta["tracks"][0]["names"][2], t.names[2]);
+        assert_eq!(meta["legend"][1]["name"], legend.labels[1]);
+        assert_eq!(meta["legend"][0]["colour"], "#1f77b4");
+        assert_eq!(meta["title"], opts.title);
+    }
+
+    #[test]
+    fn bad_tracks_are_refused_with_names() {
+        let legend = Legend::default();
+        let opts = HtmlOptions::default();
+        assert!(matches!(render_html(&[], &legend, &opts), Err(RenderError::Empty(_))));
+        let mut empty = synthetic(3, 4, 4);
+        empty.title = "walk.bvh".to_string();
+        empty.frames = 0;
+        empty.positions.clear();
+        let e = render_html(&[synthetic(3, 4, 4), empty], &legend, &opts).unwrap_err();
+        assert!(matches!(&e, RenderError::Empty(m) if m.contains("walk.bvh") && m.contains("no frames")), "{e}");
+        let mut bad = synthetic(3, 4, 4);
+        bad.positions[2 * 4 + 3].y = f32::NAN;
+        let e = render_html(&[bad], &legend, &opts).unwrap_err();
+        assert!(matches!(&e, RenderError::NonFinite(m) if m.contains("frame 2, point 3 (joint3)")), "{e}");
+        let mut labelled = synthetic(3, 4, 4);
+        labelled.frame_labels = Some(vec![None, Some(2), None]);
+        let e = render_html(&[labelled], &Legend { labels: vec!["a".into(), "b".into()] }, &opts).unwrap_err();
+        assert!(e.to_string().contains("frame 1 has label 2, but the legend has 2 labels"), "{e}");
+        let mut short = synthetic(3, 4, 4);
+        short.positions.pop();
+        assert!(matches!(render_html(&[short], &legend, &opts), Err(RenderError::Invalid(_))));
+        let e = render_html(&[synthetic(3, 4, 4)], &legend, &HtmlOptions { speed: f64::NAN, ..opts.clone() }).unwrap_err();
+        assert!(e.to_string().contains("speed"), "{e}");
+    }
+
+    #[test]
+    fn same_input_same_page() {
+        let tracks = [synthetic(40, 9, 5), synthetic(30, 6, 6)];
+        let opts = HtmlOptions { overlay: true, follow: true, autoplay: false, speed: 0.3, title: "t".into() };
+        let a = render_html(&tracks, &Legend::default(), &opts).unwrap();
+        let b = render_html(&tracks, &Legend::default(), &opts).unwrap();
+        assert!(a == b, "two renders differ");
+        assert!(a.contains(r#""overlay":true"#) && a.contains(r#""speed":0.3"#));
+    }
+
+    #[test]
+    fn template_pieces() {
+        assert_eq!(base64(b""), "");
+        assert_eq!(base64(b"f"), "Zg==");
+        assert_eq!(base64(b"fo"), "Zm8=");
+        assert_eq!(base64(b"foo"), "Zm9v");
+        assert_eq!(base64(b"foobar\xff"), "Zm9vYmFy/w==");
+        assert_eq!(unbase64(&base64(&[0, 255, 7, 9, 128])), [0, 255, 7, 9, 128]);
+        // Inserted text is not scanned again, and unknown markers stay as they are.
+        assert_eq!(fill("a{{X}}b{{Y}}c{{", &[("X", "{{Y}}"), ("Y", "1")]), "a{{Y}}b1c{{");
+        assert_eq!(fill("{{NOPE}}", &[]), "{{NOPE}}");
+        assert_eq!(escape_html(r#"<a href="x">'&'"#), "&lt;a href=&quot;x&quot;&gt;&#39;&amp;&#39;");
+        assert_eq!(script_json(r#"{"a":"</script><!--&"}"#), r#"{"a":"\u003c/script\u003e\u003c!--\u0026"}"#);
+        // Our own files must not end their elements early.
+        for (name, text) in [("viewer.js", JS), ("viewer.css", CSS)] {
+            let lower = text.to_ascii_lowercase();
+            assert!(!lower.contains("</script") && !lower.contains("</style") && !lower.contains("<!--"), "{name}");
+        }
+        for marker in ["{{TITLE}}", "{{CSS}}", "{{META}}", "{{DATA}}", "{{JS}}"] {
+            assert_eq!(TEMPLATE.matches(marker).count(), 1, "{marker}");
+        }
+    }
+}
