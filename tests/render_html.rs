@@ -117,6 +117,8 @@ fn check(result: &serde_json::Value, what: &str) {
         // A skeleton and its grid cover far more than a few hundred pixels of an 800x560 canvas.
         assert!(ink.as_u64().unwrap() > 1000, "{what}: canvas almost blank at frame {i}: {result}");
     }
+    let (tip, wanted) = (result["hover"].as_str().unwrap(), result["hoverWanted"].as_str().unwrap());
+    assert!(!wanted.trim().is_empty() && tip.starts_with(wanted), "{what}: hovering a joint shows '{tip}', not its name and track '{wanted}'");
     let probe = result["probeError"].as_f64().expect("probe error");
     assert!(probe < 0.01, "{what}: the page decodes positions {probe} levels away from html.rs's quantisation: {result}");
     assert!(result["diff"].as_u64().unwrap() > 200, "{what}: the two frames look the same: {result}");

@@ -7,7 +7,7 @@
   const $ = (id) => document.getElementById(id);
   const canvas = $('view'), ctx = canvas.getContext('2d');
   const FOV = 40 * Math.PI / 180;
-  const BACKGROUND = '#fafafa', GRID = '#d8d8d8', BONE = '#333333';
+  const BACKGROUND = '#fafafa', GRID = '#dadada', SHADOW = '#c4c4c4', BONE = '#333333';
 
   // ---- data ----------------------------------------------------------------------------------
 
@@ -56,11 +56,13 @@
     }
   }
 
-  // Bounds, ground, body size and path of a set of tracks (one view).
+  // Bounds, ground and body size of a set of tracks (one view), and the box around the first
+  // track's root that following keeps in view (sideways relative to the root, heights absolute).
   function measure(tracks) {
     const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    const rlo = [Infinity, Infinity, Infinity], rhi = [-Infinity, -Infinity, -Infinity];
     let body = 0;
-    for (const t of tracks) {
+    tracks.forEach((t, k) => {
       for (let i = 0; i < t.pos.length; i += 3) {
         for (let a = 0; a < 3; a++) {
           const v = t.pos[i + a];
@@ -72,19 +74,23 @@
       const every = Math.max(1, Math.floor(t.frames / 200));
       for (let f = 0; f < t.frames; f += every) {
         const l = [Infinity, Infinity, Infinity], h = [-Infinity, -Infinity, -Infinity];
+        const r = root(tracks[0], Math.min(f, tracks[0].frames - 1));
         for (let p = 0; p < t.points; p++) {
           for (let a = 0; a < 3; a++) {
             const v = t.pos[(f * t.points + p) * 3 + a];
             if (v < l[a]) l[a] = v;
             if (v > h[a]) h[a] = v;
+            const rel = a === 1 ? v : v - r[a];
+            if (rel < rlo[a]) rlo[a] = rel;
+            if (rel > rhi[a]) rhi[a] = rel;
           }
         }
         body = Math.max(body, Math.hypot(h[0] - l[0], h[1] - l[1], h[2] - l[2]));
       }
-    }
+    });
     const size = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     body = body > 0 ? body : (size > 0 ? size : 1);
-    return { lo, hi, body, ground: lo[1], centre: lo.map((v, a) => (v + hi[a]) / 2), radius: Math.max(size, body) / 2 };
+    return { lo, hi, rlo, rhi, body, ground: lo[1] };
   }
 
   function root(t, f) {
@@ -99,7 +105,8 @@
   const maxFps = Math.max(...tracks.map((t) => t.fps));
   const duration = Math.max(...tracks.map((t) => t.frames / t.fps));
   const steps = Math.max(1, Math.round(duration * maxFps));
-  const cam = { yaw: 0.5, pitch: 0.3, zoom: 1, panX: 0, panY: 0 };
+  const DEFAULT_PITCH = 0.3;
+  const cam = { yaw: 0.5, pitch: DEFAULT_PITCH, zoom: 1, panX: 0, panY: 0 };
   let defaultYaw = 0.5;
   let time = 0, playing = meta.autoplay, speed = meta.speed, follow = meta.follow, dirty = true;
   let hovered = null, projected = [];
@@ -114,36 +121,58 @@
 
   // ---- camera and projection -----------------------------------------------------------------
 
+  function orientation(yaw, pitch) {
+    const cp = Math.cos(pitch), sp = Math.sin(pitch), cy = Math.cos(yaw), sy = Math.sin(yaw);
+    return {
+      back: [cp * sy, sp, cp * cy],                 // from the target towards the eye
+      right: [cy, 0, -sy],
+      up: [-sp * sy, cp, -sp * cy],                 // back x right
+    };
+  }
+
+  const dot = (u, v) => u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+
+  // The distance at which a box fills the view from the default direction: every corner inside
+  // the frustum. Fitted once per view shape, not per orbit, so orbiting never zooms.
+  function fitDistance(lo, hi, aspect) {
+    const o = orientation(defaultYaw, DEFAULT_PITCH);
+    const tanY = Math.tan(FOV / 2), tanX = tanY * aspect;
+    const half = [0, 1, 2].map((a) => (hi[a] - lo[a]) / 2);
+    let d = 0;
+    for (let c = 0; c < 8; c++) {
+      const v = half.map((h, a) => (c >> a) & 1 ? h : -h);
+      const z = dot(v, o.back);
+      d = Math.max(d, z + Math.abs(dot(v, o.right)) / tanX, z + Math.abs(dot(v, o.up)) / tanY);
+    }
+    return d * 1.08;
+  }
+
   // A camera for one view rectangle: orbit about the view's target at a distance that fits the
-  // view's radius (its whole path, or its body when following), whatever the creature's size.
+  // view's whole path (or, following, the box around its root), whatever the creature's size.
   function camera(view, rect) {
     const m = view.m;
-    let target = m.centre.slice(), radius = m.radius;
+    let lo = m.lo, hi = m.hi;
     if (follow) {
       const r = root(view.tracks[0], frameOf(view.tracks[0], time));
-      target = [r[0], m.ground + m.body / 3, r[2]];
-      radius = m.body * 0.6;
+      lo = [r[0] + m.rlo[0], m.rlo[1], r[2] + m.rlo[2]];
+      hi = [r[0] + m.rhi[0], m.rhi[1], r[2] + m.rhi[2]];
     }
+    const target = lo.map((v, a) => (v + hi[a]) / 2);
     const aspect = rect.w / rect.h;
-    const dist = (radius * 1.15) / (Math.tan(FOV / 2) * Math.min(1, aspect)) / cam.zoom;
-    const cp = Math.cos(cam.pitch), sp = Math.sin(cam.pitch), cy = Math.cos(cam.yaw), sy = Math.sin(cam.yaw);
-    const back = [cp * sy, sp, cp * cy];                 // from target towards the eye
-    const right = [cy, 0, -sy];
-    const up = [-sp * sy, cp, -sp * cy];                 // back x right
-    // Pan moves the target in the screen plane, in units of the fitted radius.
-    for (let a = 0; a < 3; a++) target[a] += (cam.panX * right[a] + cam.panY * up[a]) * radius;
+    const fit = fitDistance(lo, hi, aspect), dist = fit / cam.zoom;
+    const { back, right, up } = orientation(cam.yaw, cam.pitch);
+    // Pan moves the target in the screen plane, in units of the fitted view's half height.
+    const unit = fit * Math.tan(FOV / 2);
+    for (let a = 0; a < 3; a++) target[a] += (cam.panX * right[a] + cam.panY * up[a]) * unit;
     const eye = target.map((v, a) => v + back[a] * dist);
     const focal = (rect.h / 2) / Math.tan(FOV / 2);
     const near = dist * 0.02;
     return {
-      rect, dist, near,
       project(x, y, z) {
         const d = [x - eye[0], y - eye[1], z - eye[2]];
-        const depth = -(d[0] * back[0] + d[1] * back[1] + d[2] * back[2]);
+        const depth = -dot(d, back);
         if (depth < near) return null;
-        const sx = d[0] * right[0] + d[2] * right[2];
-        const sy2 = d[0] * up[0] + d[1] * up[1] + d[2] * up[2];
-        return [rect.x + rect.w / 2 + (sx * focal) / depth, rect.y + rect.h / 2 - (sy2 * focal) / depth, depth];
+        return [rect.x + rect.w / 2 + (dot(d, right) * focal) / depth, rect.y + rect.h / 2 - (dot(d, up) * focal) / depth, depth];
       },
     };
   }
@@ -198,6 +227,15 @@
       const i = (f * t.points + p) * 3;
       pts.push(c.project(t.pos[i], t.pos[i + 1], t.pos[i + 2]));
     }
+    // Shadows on the ground show height and depth that one projection hides.
+    ctx.strokeStyle = SHADOW;
+    ctx.lineWidth = 2;
+    for (let p = 0; p < t.points; p++) {
+      const q = t.parents[p];
+      if (q === null) continue;
+      const i = (f * t.points + p) * 3, j = (f * t.points + q) * 3;
+      line(c.project(t.pos[j], view.m.ground, t.pos[j + 2]), c.project(t.pos[i], view.m.ground, t.pos[i + 2]));
+    }
     const plain = meta.overlay && tracks.length > 1 ? meta.trackColours[t.index] : BONE;
     const colour = (p) => (t.pointLabels && labelColour(t.pointLabels[p])) || plain;
     // Overlaid tracks after the first are dashed, so they stay apart even in label colours.
@@ -248,7 +286,7 @@
     drawGrid(view, c);
     view.tracks.forEach((t, k) => drawTrack(view, c, t, k));
     ctx.fillStyle = '#222';
-    ctx.font = '13px system-ui, sans-serif';
+    ctx.font = '12px system-ui, sans-serif';
     let y = r.y + 18;
     for (const t of view.tracks) {
       const f = frameOf(t, time);
@@ -258,11 +296,21 @@
       y += 17;
     }
     ctx.restore();
-    if (r.x > 0) {
-      ctx.strokeStyle = '#ccc';
-      ctx.lineWidth = 1;
-      line([r.x + 0.5, r.y], [r.x + 0.5, r.y + r.h]);
+    ctx.strokeStyle = '#ccc';
+    ctx.lineWidth = 1;
+    if (r.x > 0) line([r.x + 0.5, r.y], [r.x + 0.5, r.y + r.h]);
+    if (r.y > 0) line([r.x, r.y + 0.5], [r.x + r.w, r.y + 0.5]);
+  }
+
+  // Columns and rows for n views: the layout whose cells fit the largest landscape (4:3) picture.
+  function grid(n, w, h) {
+    let best = [n, 1], score = -1;
+    for (let cols = 1; cols <= n; cols++) {
+      const rows = Math.ceil(n / cols);
+      const s = Math.min(w / cols / 4 * 3, h / rows);
+      if (s > score) { score = s; best = [cols, rows]; }
     }
+    return best;
   }
 
   function draw() {
@@ -276,9 +324,10 @@
     ctx.fillStyle = BACKGROUND;
     ctx.fillRect(0, 0, w, h);
     projected = [];
+    const [cols, rows] = grid(views.length, w, h);
     views.forEach((v, i) => {
-      const vw = w / views.length;
-      v.rect = { x: i * vw, y: 0, w: vw, h };
+      const vw = w / cols, vh = h / rows;
+      v.rect = { x: (i % cols) * vw, y: Math.floor(i / cols) * vh, w: vw, h: vh };
       drawView(v);
     });
     if (hovered) {
@@ -299,7 +348,7 @@
 
   function setPlaying(p) { playing = p; dirty = true; }
   function stepBy(n) { setPlaying(false); time = Math.max(0, Math.min(duration - 1e-9, (Math.floor(time * maxFps + 1e-6) + n) / maxFps)); }
-  function resetCamera() { Object.assign(cam, { yaw: defaultYaw, pitch: 0.3, zoom: 1, panX: 0, panY: 0 }); dirty = true; }
+  function resetCamera() { Object.assign(cam, { yaw: defaultYaw, pitch: DEFAULT_PITCH, zoom: 1, panX: 0, panY: 0 }); dirty = true; }
 
   function setupControls() {
     $('play').addEventListener('click', () => setPlaying(!playing));
@@ -347,7 +396,7 @@
         const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
         drag.x = e.clientX; drag.y = e.clientY;
         if (drag.pan) {
-          const scale = 2 / (box.height * cam.zoom);
+          const scale = 2 / (views[0].rect.h * cam.zoom);
           cam.panX -= dx * scale;
           cam.panY += dy * scale;
         } else {
@@ -453,7 +502,12 @@
     for (let i = 0; i < a.length; i += 4) {
       if (a[i] !== b[i] || a[i + 1] !== b[i + 1] || a[i + 2] !== b[i + 2]) diff++;
     }
+    // Hovering the first drawn joint must name it.
+    const target = projected[0];
+    hover(target.x, target.y);
+    const tip = $('tip').hidden ? '' : $('tip').textContent;
     return {
+      hover: tip, hoverWanted: `${target.name}\n${target.track.title}`,
       width: canvas.width, height: canvas.height, tracks: tracks.length, views: views.length,
       frames: tracks.map((t) => [frameOf(t, 0), frameOf(t, duration / 2)]),
       ink: [ink(a), ink(b)], diff,
