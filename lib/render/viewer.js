@@ -186,11 +186,19 @@
 
   // ---- drawing -------------------------------------------------------------------------------
 
-  function line(a, b) {
+  // Adds a segment between two projected points to the current path (skipped when either end
+  // is behind the camera); `stroke` draws a batch of them at once, which keeps frames cheap.
+  function segment(a, b) {
     if (!a || !b) return;
-    ctx.beginPath();
     ctx.moveTo(a[0], a[1]);
     ctx.lineTo(b[0], b[1]);
+  }
+
+  function stroke(style, width, add) {
+    ctx.beginPath();
+    add();
+    ctx.strokeStyle = style;
+    ctx.lineWidth = width;
     ctx.stroke();
   }
 
@@ -204,20 +212,20 @@
     x0 = Math.floor(x0 / step) * step; x1 = Math.ceil(x1 / step) * step;
     z0 = Math.floor(z0 / step) * step; z1 = Math.ceil(z1 / step) * step;
     const y = m.ground;
-    ctx.strokeStyle = GRID;
-    ctx.lineWidth = 1;
     // Lines are cut into pieces so perspective clipping at the near plane only drops short bits.
     const pieces = 8;
-    for (let x = x0; x <= x1 + step / 2; x += step) {
-      for (let i = 0; i < pieces; i++) {
-        line(c.project(x, y, z0 + ((z1 - z0) * i) / pieces), c.project(x, y, z0 + ((z1 - z0) * (i + 1)) / pieces));
+    stroke(GRID, 1, () => {
+      for (let x = x0; x <= x1 + step / 2; x += step) {
+        for (let i = 0; i < pieces; i++) {
+          segment(c.project(x, y, z0 + ((z1 - z0) * i) / pieces), c.project(x, y, z0 + ((z1 - z0) * (i + 1)) / pieces));
+        }
       }
-    }
-    for (let z = z0; z <= z1 + step / 2; z += step) {
-      for (let i = 0; i < pieces; i++) {
-        line(c.project(x0 + ((x1 - x0) * i) / pieces, y, z), c.project(x0 + ((x1 - x0) * (i + 1)) / pieces, y, z));
+      for (let z = z0; z <= z1 + step / 2; z += step) {
+        for (let i = 0; i < pieces; i++) {
+          segment(c.project(x0 + ((x1 - x0) * i) / pieces, y, z), c.project(x0 + ((x1 - x0) * (i + 1)) / pieces, y, z));
+        }
       }
-    }
+    });
   }
 
   function drawTrack(view, c, t, k) {
@@ -228,26 +236,27 @@
       pts.push(c.project(t.pos[i], t.pos[i + 1], t.pos[i + 2]));
     }
     // Shadows on the ground show height and depth that one projection hides.
-    ctx.strokeStyle = SHADOW;
-    ctx.lineWidth = 2;
-    for (let p = 0; p < t.points; p++) {
-      const q = t.parents[p];
-      if (q === null) continue;
-      const i = (f * t.points + p) * 3, j = (f * t.points + q) * 3;
-      line(c.project(t.pos[j], view.m.ground, t.pos[j + 2]), c.project(t.pos[i], view.m.ground, t.pos[i + 2]));
-    }
+    stroke(SHADOW, 2, () => {
+      for (let p = 0; p < t.points; p++) {
+        const q = t.parents[p];
+        if (q === null) continue;
+        const i = (f * t.points + p) * 3, j = (f * t.points + q) * 3;
+        segment(c.project(t.pos[j], view.m.ground, t.pos[j + 2]), c.project(t.pos[i], view.m.ground, t.pos[i + 2]));
+      }
+    });
     const plain = meta.overlay && tracks.length > 1 ? meta.trackColours[t.index] : BONE;
     const colour = (p) => (t.pointLabels && labelColour(t.pointLabels[p])) || plain;
     // Overlaid tracks after the first are dashed, so they stay apart even in label colours.
     ctx.setLineDash(meta.overlay && k > 0 ? [6, 4] : []);
-    ctx.lineWidth = 2.5;
     ctx.lineCap = 'round';
+    const bones = new Map();
     for (let p = 0; p < t.points; p++) {
-      const q = t.parents[p];
-      if (q === null) continue;
-      ctx.strokeStyle = colour(p);
-      line(pts[q], pts[p]);
+      if (t.parents[p] === null) continue;
+      const col = colour(p);
+      if (!bones.has(col)) bones.set(col, []);
+      bones.get(col).push(p);
     }
+    for (const [col, children] of bones) stroke(col, 2.5, () => children.forEach((p) => segment(pts[t.parents[p]], pts[p])));
     ctx.setLineDash([]);
     const feet = new Set(t.feet);
     for (let p = 0; p < t.points; p++) {
@@ -296,10 +305,10 @@
       y += 17;
     }
     ctx.restore();
-    ctx.strokeStyle = '#ccc';
-    ctx.lineWidth = 1;
-    if (r.x > 0) line([r.x + 0.5, r.y], [r.x + 0.5, r.y + r.h]);
-    if (r.y > 0) line([r.x, r.y + 0.5], [r.x + r.w, r.y + 0.5]);
+    stroke('#ccc', 1, () => {
+      if (r.x > 0) segment([r.x + 0.5, r.y], [r.x + 0.5, r.y + r.h]);
+      if (r.y > 0) segment([r.x, r.y + 0.5], [r.x + r.w, r.y + 0.5]);
+    });
   }
 
   // Columns and rows for n views: the layout whose cells fit the largest landscape (4:3) picture.
@@ -338,7 +347,7 @@
       ctx.stroke();
     }
     const slider = $('slider');
-    if (document.activeElement !== slider || playing) slider.value = Math.min(steps - 1, Math.floor(time * maxFps + 1e-6));
+    slider.value = Math.min(steps - 1, Math.floor(time * maxFps + 1e-6));
     $('clock').textContent = `${time.toFixed(2)} s`;
     $('play').textContent = playing ? 'Pause' : 'Play';
     dirty = false;
@@ -351,10 +360,12 @@
   function resetCamera() { Object.assign(cam, { yaw: defaultYaw, pitch: DEFAULT_PITCH, zoom: 1, panX: 0, panY: 0 }); dirty = true; }
 
   function setupControls() {
-    $('play').addEventListener('click', () => setPlaying(!playing));
+    // Blurred after a click, so space (our play key) never also presses the focused button.
+    $('play').addEventListener('click', () => { setPlaying(!playing); $('play').blur(); });
     const slider = $('slider');
     slider.max = String(steps - 1);
-    slider.addEventListener('input', () => { time = Number(slider.value) / maxFps; dirty = true; });
+    // Scrubbing pauses: the picture shows the frame under the thumb.
+    slider.addEventListener('input', () => { playing = false; time = Number(slider.value) / maxFps; dirty = true; });
     const select = $('speed');
     const speeds = [0.1, 0.25, 0.5, 1, 2, 4];
     if (!speeds.includes(speed)) speeds.push(speed);
@@ -373,6 +384,8 @@
     $('reset').addEventListener('click', resetCamera);
     window.addEventListener('keydown', (e) => {
       if (e.target instanceof HTMLInputElement && e.target.type !== 'range' && e.target.type !== 'checkbox') return;
+      // The focused slider steps with the arrows itself.
+      if (e.target === slider && e.key.startsWith('Arrow')) return;
       if (e.key === ' ') { setPlaying(!playing); e.preventDefault(); }
       else if (e.key === 'ArrowRight') { stepBy(1); e.preventDefault(); }
       else if (e.key === 'ArrowLeft') { stepBy(-1); e.preventDefault(); }
@@ -385,10 +398,12 @@
     let drag = null;
     canvas.addEventListener('pointerdown', (e) => {
       drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey || e.button === 2 };
-      canvas.setPointerCapture(e.pointerId);
+      // Capture keeps a drag going outside the canvas; a pointer that is already gone cannot be
+      // captured, and the drag then simply ends at the canvas edge.
+      try { canvas.setPointerCapture(e.pointerId); } catch (_) { /* see above */ }
       canvas.classList.add('dragging');
     });
-    canvas.addEventListener('pointerup', (e) => { drag = null; canvas.releasePointerCapture(e.pointerId); canvas.classList.remove('dragging'); });
+    canvas.addEventListener('pointerup', () => { drag = null; canvas.classList.remove('dragging'); });
     canvas.addEventListener('contextmenu', (e) => e.preventDefault());
     canvas.addEventListener('pointermove', (e) => {
       const box = canvas.getBoundingClientRect();
@@ -506,8 +521,22 @@
     const target = projected[0];
     hover(target.x, target.y);
     const tip = $('tip').hidden ? '' : $('tip').textContent;
+    // Drag to orbit, shift-drag to pan, wheel to zoom, space to play: the handlers run cleanly.
+    const was = { ...cam };
+    const at = (x, y, extra) => Object.assign({ clientX: x, clientY: y, pointerId: 1, bubbles: true }, extra);
+    canvas.dispatchEvent(new PointerEvent('pointerdown', at(100, 100)));
+    canvas.dispatchEvent(new PointerEvent('pointermove', at(140, 110)));
+    canvas.dispatchEvent(new PointerEvent('pointerup', at(140, 110)));
+    canvas.dispatchEvent(new PointerEvent('pointerdown', at(100, 100, { shiftKey: true })));
+    canvas.dispatchEvent(new PointerEvent('pointermove', at(90, 120, { shiftKey: true })));
+    canvas.dispatchEvent(new PointerEvent('pointerup', at(90, 120)));
+    canvas.dispatchEvent(new WheelEvent('wheel', { deltaY: -200, bubbles: true, cancelable: true }));
+    window.dispatchEvent(new KeyboardEvent('keydown', { key: ' ', bubbles: true }));
+    const controls = { orbited: cam.yaw !== was.yaw && cam.pitch !== was.pitch, panned: cam.panX !== was.panX, zoomed: cam.zoom > was.zoom, played: playing };
+    draw();
+    playing = false;
     return {
-      hover: tip, hoverWanted: `${target.name}\n${target.track.title}`,
+      controls, hover: tip, hoverWanted: `${target.name}\n${target.track.title}`,
       width: canvas.width, height: canvas.height, tracks: tracks.length, views: views.length,
       frames: tracks.map((t) => [frameOf(t, 0), frameOf(t, duration / 2)]),
       ink: [ink(a), ink(b)], diff,
