@@ -119,7 +119,7 @@ fn check(result: &serde_json::Value, what: &str) {
     }
     let (tip, wanted) = (result["hover"].as_str().unwrap(), result["hoverWanted"].as_str().unwrap());
     assert!(!wanted.trim().is_empty() && tip.starts_with(wanted), "{what}: hovering a joint shows '{tip}', not its name and track '{wanted}'");
-    for control in ["orbited", "panned", "zoomed", "played"] {
+    for control in ["orbited", "panned", "zoomed", "played", "advanced"] {
         assert_eq!(result["controls"][control], true, "{what}: the page was not {control} by its controls: {result}");
     }
     let probe = result["probeError"].as_f64().expect("probe error");
