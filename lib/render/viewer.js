@@ -551,11 +551,13 @@
   }
 
   async function main() {
+    const started = performance.now();
     const bytes = await inflate(document.getElementById('data').textContent);
     if (bytes.length !== meta.dataBytes) throw new Error(`motion data is ${bytes.length} bytes, expected ${meta.dataBytes}`);
     tracks.forEach((t, i) => { t.index = i; decodeTrack(t, bytes); });
     if (meta.overlay) views.push({ tracks, m: measure(tracks) });
     else for (const t of tracks) views.push({ tracks: [t], m: measure([t]) });
+    const loadMs = performance.now() - started;
     // Walks go left to right: look at the first track's path from its side.
     const t0 = tracks[0], a = root(t0, 0), b = root(t0, t0.frames - 1);
     const dx = b[0] - a[0], dz = b[2] - a[2];
@@ -574,6 +576,7 @@
       tick(1000);
       tick(1100);
       result.controls.advanced = Math.abs(time - 0.1 * speed) < 1e-9;
+      result.loadMs = Math.round(loadMs);
       report(result);
       return;
     }
