@@ -134,10 +134,11 @@
 
   // The distance at which a box fills the view from the default direction: every corner inside
   // the frustum. Fitted once per view shape, not per orbit, so orbiting never zooms.
-  function fitDistance(lo, hi, aspect) {
+  function fitDistance(lo, hi, aspect, body) {
     const o = orientation(defaultYaw, DEFAULT_PITCH);
     const tanY = Math.tan(FOV / 2), tanX = tanY * aspect;
-    const half = [0, 1, 2].map((a) => (hi[a] - lo[a]) / 2);
+    // A flat or still creature still gets some room (and the camera a distance above zero).
+    const half = [0, 1, 2].map((a) => Math.max((hi[a] - lo[a]) / 2, body * 0.05));
     let d = 0;
     for (let c = 0; c < 8; c++) {
       const v = half.map((h, a) => (c >> a) & 1 ? h : -h);
@@ -159,7 +160,7 @@
     }
     const target = lo.map((v, a) => (v + hi[a]) / 2);
     const aspect = rect.w / rect.h;
-    const fit = fitDistance(lo, hi, aspect), dist = fit / cam.zoom;
+    const fit = fitDistance(lo, hi, aspect, m.body), dist = fit / cam.zoom;
     const { back, right, up } = orientation(cam.yaw, cam.pitch);
     // Pan moves the target in the screen plane, in units of the fitted view's half height.
     const unit = fit * Math.tan(FOV / 2);
@@ -457,9 +458,11 @@
   function setupLegend() {
     const box = $('legend');
     const rows = meta.legend.map((l) => [l.colour, l.name]);
-    // Overlaid tracks without labels are told apart by colour: list them instead.
-    if (meta.overlay && tracks.length > 1 && !tracks.some((t) => t.pointLabels)) {
-      tracks.forEach((t, i) => rows.push([meta.trackColours[i], t.title + (i > 0 ? ' (dashed)' : '')]));
+    // Overlaid tracks are told apart by colour when nothing else colours them, and always by
+    // line style: list them too.
+    if (meta.overlay && tracks.length > 1) {
+      const labelled = tracks.some((t) => t.pointLabels);
+      tracks.forEach((t, i) => rows.push([labelled ? BONE : meta.trackColours[i], `${t.title} (${i > 0 ? 'dashed' : 'solid'})`]));
     }
     for (const [colour, name] of rows) {
       const row = document.createElement('div');
@@ -575,7 +578,7 @@
       playing = true;
       tick(1000);
       tick(1100);
-      result.controls.advanced = Math.abs(time - 0.1 * speed) < 1e-9;
+      result.controls.advanced = Math.abs(time - ((0.1 * speed) % duration)) < 1e-9;
       result.loadMs = Math.round(loadMs);
       report(result);
       return;
