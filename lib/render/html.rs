@@ -8,9 +8,10 @@
 //! Positions are quantised to 16-bit levels of 1/2000 of the creature's size (error at most
 //! 0.025% of the body per coordinate; see `quantise`), stored relative to the parent point,
 //! and predicted from the previous frame(s) of the same series, so what deflate sees is mostly
-//! small residuals in two byte planes. Real 30 fps mocap takes about 1-1.4 bytes per point and
-//! frame after base64, so a 5000-frame, 115-point clip makes a page of 0.7-1.0 MB
-//! (`cargo test --test render_html -- --ignored --nocapture` measures it on the corpus).
+//! small residuals in two byte planes. Real 30 fps mocap takes about 1.4-2.1 bytes per point
+//! and frame after base64 (faster motion costs more), so a 5000-frame, 115-point clip makes a
+//! page of about 0.8-1.2 MB (`cargo test --test render_html -- --ignored --nocapture` measures
+//! it on the corpus).
 //!
 //! The page also carries a self test: opened with `#selftest` it draws two frames, counts the
 //! drawn pixels of each and the pixels that differ, and writes the result (and any script
@@ -30,11 +31,14 @@ const LEVELS: f64 = 65535.0;
 const BODY_LEVELS: f64 = 2000.0;
 /// Decoded positions per track that the page's self test checks its decoder against.
 const PROBES: usize = 16;
+/// Most points x frames in one page: about 20 MB of page and 200 MB of browser memory, far
+/// beyond what plays well; longer material should be cut or subsampled first.
+const MAX_POINT_FRAMES: usize = 10_000_000;
 
 /// How the page plays.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HtmlOptions {
-    /// The page title (browser tab and heading).
+    /// The page title (the browser tab's).
     pub title: String,
     /// Initial playback speed (1.0 = the motion's own frame rate).
     pub speed: f64,
@@ -54,6 +58,12 @@ impl Default for HtmlOptions {
 
 /// The viewer page for `tracks`, coloured with `legend` (see [`super::labels`]).
 pub fn render_html(tracks: &[Track], legend: &Legend, opts: &HtmlOptions) -> Result<String, RenderError> {
+    let total = tracks.iter().fold(0usize, |sum, t| sum.saturating_add(t.frames.saturating_mul(t.points())));
+    if total > MAX_POINT_FRAMES {
+        return Err(RenderError::TooLarge(format!(
+            "{total} points x frames would make a page too big to play ({MAX_POINT_FRAMES} at most): show fewer frames or tracks"
+        )));
+    }
     validate(tracks, legend)?;
     if !opts.speed.is_finite() || opts.speed <= 0.0 {
         return Err(RenderError::Invalid(format!("speed must be a positive number, got {}", opts.speed)));
@@ -574,6 +584,10 @@ mod tests {
         let mut short = synthetic(3, 4, 4);
         short.positions.pop();
         assert!(matches!(render_html(&[short], &legend, &opts), Err(RenderError::Invalid(_))));
+        let mut huge = synthetic(1, 4, 4);
+        huge.frames = MAX_POINT_FRAMES / 4 + 1;
+        // Refused from the sizes alone, before looking at (here missing) positions.
+        assert!(matches!(render_html(&[huge], &legend, &opts), Err(RenderError::TooLarge(_))));
         let e = render_html(&[synthetic(3, 4, 4)], &legend, &HtmlOptions { speed: f64::NAN, ..opts.clone() }).unwrap_err();
         assert!(e.to_string().contains("speed"), "{e}");
     }

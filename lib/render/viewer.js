@@ -111,8 +111,9 @@
   let time = 0, playing = meta.autoplay, speed = meta.speed, follow = meta.follow, dirty = true;
   let hovered = null, projected = [];
 
-  function frameOf(t, time) {
-    return Math.max(0, Math.min(t.frames - 1, Math.floor(time * t.fps + 1e-6)));
+  // The frame a track shows at a time (tracks shorter than the longest hold their last frame).
+  function frameOf(t, at) {
+    return Math.max(0, Math.min(t.frames - 1, Math.floor(at * t.fps + 1e-6)));
   }
 
   function labelColour(index) {
@@ -263,7 +264,7 @@
     for (let p = 0; p < t.points; p++) {
       const s = pts[p];
       if (!s || t.endSite[p]) continue;
-      projected.push({ x: s[0], y: s[1], name: t.names[p], track: t, frame: f });
+      projected.push({ x: s[0], y: s[1], point: p, name: t.names[p], track: t, frame: f });
       ctx.fillStyle = colour(p);
       if (feet.has(p)) {
         ctx.strokeStyle = colour(p);
@@ -340,6 +341,8 @@
       v.rect = { x: (i % cols) * vw, y: Math.floor(i / cols) * vh, w: vw, h: vh };
       drawView(v);
     });
+    // The hovered joint stays marked while it moves.
+    if (hovered) hovered = projected.find((p) => p.track === hovered.track && p.point === hovered.point) || null;
     if (hovered) {
       ctx.strokeStyle = '#d00';
       ctx.lineWidth = 2;
@@ -384,7 +387,8 @@
     followBox.addEventListener('change', () => { follow = followBox.checked; cam.panX = cam.panY = 0; dirty = true; });
     $('reset').addEventListener('click', resetCamera);
     window.addEventListener('keydown', (e) => {
-      if (e.target instanceof HTMLInputElement && e.target.type !== 'range' && e.target.type !== 'checkbox') return;
+      // Keys typed into the speed list stay there.
+      if (e.target instanceof HTMLSelectElement) return;
       // The focused slider steps with the arrows itself.
       if (e.target === slider && e.key.startsWith('Arrow')) return;
       if (e.key === ' ') { setPlaying(!playing); e.preventDefault(); }
@@ -451,7 +455,7 @@
     tip.hidden = false;
     tip.style.left = `${x + 14}px`;
     tip.style.top = `${y + 10}px`;
-    if (!hovered || hovered.name !== best.name || hovered.track !== best.track) dirty = true;
+    if (!hovered || hovered.point !== best.point || hovered.track !== best.track) dirty = true;
     hovered = best;
   }
 
