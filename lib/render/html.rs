@@ -154,10 +154,7 @@ fn validate(tracks: &[Track], legend: &Legend) -> Result<(), RenderError> {
         }
         if let Some(i) = t.positions.iter().position(|p| !p.is_finite()) {
             let (f, p) = (i / n, i % n);
-            return Err(RenderError::NonFinite(format!(
-                "{name}: frame {f}, point {p} ({}) is not finite: {}",
-                t.names[p], t.positions[i]
-            )));
+            return Err(RenderError::NonFinite(format!("{name}: frame {f}, point {p} ({}) is not finite: {}", t.names[p], t.positions[i])));
         }
     }
     Ok(())
@@ -403,7 +400,8 @@ mod tests {
     fn synthetic(frames: usize, points: usize, seed: u64) -> Track {
         let mut rng = SplitMix64::new(seed);
         let parents: Vec<Option<usize>> = (0..points).map(|p| if p == 0 { None } else { Some((p - 1) / 3) }).collect();
-        let swing: Vec<[f64; 6]> = (0..points).map(|_| std::array::from_fn(|i| if i < 3 { rng.range(0.02, 0.15) } else { rng.range(0.4, 1.6) })).collect();
+        let swing: Vec<[f64; 6]> =
+            (0..points).map(|_| std::array::from_fn(|i| if i < 3 { rng.range(0.02, 0.15) } else { rng.range(0.4, 1.6) })).collect();
         let rest: Vec<[f64; 3]> = (0..points).map(|_| [rng.range(-0.4, 0.4), rng.range(0.0, 1.8), rng.range(-0.3, 0.3)]).collect();
         let fps = 30.0;
         let mut positions = Vec::with_capacity(frames * points);
@@ -413,7 +411,10 @@ mod tests {
             for p in 0..points {
                 let v: [f64; 3] = std::array::from_fn(|a| {
                     let centre = [cx, 0.0, cz][a];
-                    centre + rest[p][a] + swing[p][a] * (swing[p][a + 3] * std::f64::consts::TAU * t + p as f64).sin() + rng.range(-5e-4, 5e-4)
+                    centre
+                        + rest[p][a]
+                        + swing[p][a] * (swing[p][a + 3] * std::f64::consts::TAU * t + p as f64).sin()
+                        + rng.range(-5e-4, 5e-4)
                 });
                 positions.push(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32));
             }
