@@ -77,6 +77,8 @@ fn open(chromium: &Path, page: &Path, profile: &Path) -> Browser {
     let url = format!("file://{}#selftest", page.display());
     let mut child = Command::new(chromium)
         .args(["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-extensions", "--mute-audio"])
+        // Containers often have a tiny /dev/shm, which crashes Chromium's renderer.
+        .arg("--disable-dev-shm-usage")
         // Nothing on the page needs the network; keep the browser from reaching for it too.
         .args(["--disable-background-networking", "--disable-component-update", "--disable-sync", "--disable-default-apps"])
         .arg("--window-size=800,600")
