@@ -313,6 +313,63 @@
     });
   }
 
+  // Frame labels as a timeline under the picture: one row per labelled track, runs of equal
+  // labels as coloured bars, and the current time as a cursor.
+  function labelRuns(t) {
+    const runs = [];
+    let start = 0;
+    for (let f = 1; f <= t.frames; f++) {
+      if (f === t.frames || t.frameLabels[f] !== t.frameLabels[start]) {
+        const colour = labelColour(t.frameLabels[start]);
+        if (colour) runs.push([start / t.fps, f / t.fps, colour]);
+        start = f;
+      }
+    }
+    return runs;
+  }
+
+  function drawStrip() {
+    const strip = $('strip');
+    if (strip.hidden) return;
+    const sctx = strip.getContext('2d');
+    const w = Math.max(1, strip.clientWidth), h = Math.max(1, strip.clientHeight);
+    const dpr = window.devicePixelRatio || 1;
+    if (strip.width !== Math.round(w * dpr) || strip.height !== Math.round(h * dpr)) {
+      strip.width = Math.round(w * dpr);
+      strip.height = Math.round(h * dpr);
+    }
+    sctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    sctx.fillStyle = '#eee';
+    sctx.fillRect(0, 0, w, h);
+    const rows = tracks.filter((t) => t.runs);
+    rows.forEach((t, k) => {
+      const y0 = (k * h) / rows.length, y1 = ((k + 1) * h) / rows.length;
+      for (const [a, b, colour] of t.runs) {
+        sctx.fillStyle = colour;
+        sctx.fillRect((a / duration) * w, y0, Math.max(1, ((b - a) / duration) * w), y1 - y0);
+      }
+    });
+    sctx.fillStyle = '#000';
+    sctx.fillRect(Math.min(w - 2, (time / duration) * w), 0, 2, h);
+  }
+
+  function setupStrip() {
+    const strip = $('strip');
+    tracks.forEach((t) => { if (t.frameLabels) t.runs = labelRuns(t); });
+    const rows = tracks.filter((t) => t.runs).length;
+    if (rows === 0) return;
+    strip.style.height = `${Math.min(4, rows) * 6 + 4}px`;
+    strip.hidden = false;
+    const seek = (e) => {
+      const box = strip.getBoundingClientRect();
+      playing = false;
+      time = Math.max(0, Math.min(duration - 1e-9, ((e.clientX - box.left) / box.width) * duration));
+      dirty = true;
+    };
+    strip.addEventListener('pointerdown', seek);
+    strip.addEventListener('pointermove', (e) => { if (e.buttons) seek(e); });
+  }
+
   // Columns and rows for n views: the layout whose cells fit the largest landscape (4:3) picture.
   function grid(n, w, h) {
     let best = [n, 1], score = -1;
@@ -350,6 +407,7 @@
       ctx.arc(hovered.x, hovered.y, 7, 0, 2 * Math.PI);
       ctx.stroke();
     }
+    drawStrip();
     const slider = $('slider');
     slider.value = Math.min(steps - 1, Math.floor(time * maxFps + 1e-6));
     $('clock').textContent = `${time.toFixed(2)} s`;
@@ -572,6 +630,7 @@
     resetCamera();
     setupControls();
     setupLegend();
+    setupStrip();
     if (location.hash === '#selftest') {
       playing = false;
       const result = selftest();
