@@ -136,8 +136,8 @@ fn compare_with_reference(case: &Case) {
     println!();
     println!("Demo vs the reference's output (alpha 0.9); errors in Monkey units (rest height {:.1}):", case.target.rest_height());
     println!();
-    println!("| mode | reference frames | ours frames | ref root y range | our root y range | mean joint error, seed 0 | over seeds 0-4 | example vs ref |");
-    println!("|---|---:|---:|---|---|---:|---:|---:|");
+    println!("| mode | reference frames | ours frames | ref root y range | our root y range | mean joint error, seed 0 | over seeds 0-4 | example vs ref | ours: seed 0 vs seeds 1-4 |");
+    println!("|---|---:|---:|---|---|---:|---:|---:|---:|");
     for (mode, file, copy) in files {
         let path = dir.join(file);
         if !path.is_file() {
@@ -145,7 +145,7 @@ fn compare_with_reference(case: &Case) {
         }
         let (ref_skeleton, reference) = load(&path);
         if ref_skeleton.len() != case.target.len() {
-            println!("| {mode} | skeleton differs ({} joints) | | | | | | |", ref_skeleton.len());
+            println!("| {mode} | skeleton differs ({} joints) | | | | | | | |", ref_skeleton.len());
             continue;
         }
         let errors: Vec<(f64, Motion)> = (0..5)
@@ -161,7 +161,8 @@ fn compare_with_reference(case: &Case) {
         let looped = repeat(&case.example, reference.frames.div_ceil(case.example.frames)).first_frames(reference.frames);
         let baseline = mean_error(&looped, &reference, &case.target);
         let (ry, oy) = (root_y(&reference), root_y(ours));
-        println!("| {mode} | {} | {} | {:.2}..{:.2} | {:.2}..{:.2} | {:.2} | {:.2} | {:.2} |", reference.frames, ours.frames, ry.0, ry.1, oy.0, oy.1, errors[0].0, mean5, baseline);
+        let diversity = errors[1..].iter().map(|e| mean_error(&e.1, ours, &case.target)).sum::<f64>() / 4.0;
+        println!("| {mode} | {} | {} | {:.2}..{:.2} | {:.2}..{:.2} | {:.3} | {:.3} | {:.2} | {:.3} |", reference.frames, ours.frames, ry.0, ry.1, oy.0, oy.1, errors[0].0, mean5, baseline, diversity);
     }
 }
 

@@ -394,10 +394,17 @@ impl<'a> Plan<'a> {
         let (cm, cp) = level_clips(first);
         let mut state_m = concat(&cm).resize(first);
         let mut state_p = concat(&cp).resize(first);
+        // Bound channels are about to be overwritten by the source: they get no noise.
         let mut gauss = noise::Gaussian::new(seed);
-        for c in [&mut state_m, &mut state_p] {
-            for v in c.data.iter_mut() {
-                *v = ((*v as f64 + s.noise_sigma * gauss.next()) % 1.0) as f32;
+        for (c, mask) in [(&mut state_m, &self.mask.0), (&mut state_p, &self.mask.1)] {
+            let free: Vec<usize> = (0..c.width).filter(|&k| !mask[k]).collect();
+            for t in 0..c.frames {
+                let row = c.row_mut(t);
+                for &k in &free {
+                    let x = row[k] as f64 + s.noise_sigma * gauss.next();
+                    // fmod(x, 1) as the reference, without the slow library call.
+                    row[k] = (x - x.trunc()) as f32;
+                }
             }
         }
         // Bound channels start from the source everywhere (interpolated between key frames).

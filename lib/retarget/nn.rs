@@ -16,8 +16,8 @@ use super::features::Channels;
 use rayon::prelude::*;
 
 /// Query patches per parallel block. The Gram rows of a block overlap the next block's by
-/// `patch - 1` frames, so larger blocks waste less; 64 keeps a block's Gram rows in L2.
-const BLOCK: usize = 64;
+/// `patch - 1` frames, so larger blocks waste less; 128 keeps a block's Gram rows in L2.
+const BLOCK: usize = 128;
 /// Largest distance matrix kept in memory (entries); bigger ones are computed twice instead.
 const MAX_STORED: usize = 1 << 23;
 /// Lane width of the dot-product kernel; rows are zero-padded to a multiple of it.
@@ -103,7 +103,7 @@ impl Bank {
 }
 
 /// Four dot products of two query rows with two example rows (2x2 register tile).
-#[inline]
+#[inline(always)]
 fn dot2x2(a0: &[f32], a1: &[f32], b0: &[f32], b1: &[f32]) -> [f32; 4] {
     let (mut s00, mut s01, mut s10, mut s11) = ([0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES]);
     for (((x0, x1), y0), y1) in a0.chunks_exact(LANES).zip(a1.chunks_exact(LANES)).zip(b0.chunks_exact(LANES)).zip(b1.chunks_exact(LANES)) {
@@ -117,7 +117,7 @@ fn dot2x2(a0: &[f32], a1: &[f32], b0: &[f32], b1: &[f32]) -> [f32; 4] {
     [hsum(&s00), hsum(&s01), hsum(&s10), hsum(&s11)]
 }
 
-#[inline]
+#[inline(always)]
 fn dot(a: &[f32], b: &[f32]) -> f32 {
     let mut s = [0.0f32; LANES];
     for (x, y) in a.chunks_exact(LANES).zip(b.chunks_exact(LANES)) {
@@ -128,13 +128,37 @@ fn dot(a: &[f32], b: &[f32]) -> f32 {
     hsum(&s)
 }
 
-#[inline]
+#[inline(always)]
 fn hsum(s: &[f32; LANES]) -> f32 {
     ((s[0] + s[4]) + (s[1] + s[5])) + ((s[2] + s[6]) + (s[3] + s[7]))
 }
 
 /// `G = A B^T` for `rows` rows of `a` and `cols` rows of `b` (both of `stride` floats).
+///
+/// On x86-64 CPUs with AVX the same code is compiled a second time with AVX enabled, so the
+/// 8-lane accumulators become single registers (the baseline target has only 4-lane SSE). AVX
+/// without FMA performs exactly the same multiplications and additions in the same order, so
+/// both versions give the same bits.
 fn gram(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut Vec<f32>) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU supports AVX, checked just above; that is gram_avx's only requirement.
+            unsafe { gram_avx(a, rows, b, cols, stride, out) };
+            return;
+        }
+    }
+    gram_body(a, rows, b, cols, stride, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn gram_avx(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut Vec<f32>) {
+    gram_body(a, rows, b, cols, stride, out);
+}
+
+#[inline(always)]
+fn gram_body(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut Vec<f32>) {
     out.clear();
     out.resize(rows * cols, 0.0);
     fn row(m: &[f32], i: usize, stride: usize) -> &[f32] {

@@ -15,18 +15,21 @@ impl Gaussian {
         Gaussian { rng: SplitMix64::new(seed ^ 0x6d6f_2d72_6574_6172), spare: None }
     }
 
-    /// A standard normal value (Box-Muller, both outputs used).
+    /// A standard normal value (Marsaglia's polar method: no trigonometry, both outputs used).
     pub fn next(&mut self) -> f64 {
         if let Some(s) = self.spare.take() {
             return s;
         }
-        // 1 - unit() is in (0, 1], so the log is finite.
-        let u = 1.0 - self.rng.unit();
-        let v = self.rng.unit();
-        let r = (-2.0 * u.ln()).sqrt();
-        let (s, c) = (std::f64::consts::TAU * v).sin_cos();
-        self.spare = Some(r * s);
-        r * c
+        loop {
+            let u = 2.0 * self.rng.unit() - 1.0;
+            let v = 2.0 * self.rng.unit() - 1.0;
+            let s = u * u + v * v;
+            if s > 0.0 && s < 1.0 {
+                let k = (-2.0 * s.ln() / s).sqrt();
+                self.spare = Some(v * k);
+                return u * k;
+            }
+        }
     }
 }
 

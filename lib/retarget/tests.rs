@@ -106,7 +106,9 @@ fn a_seed_gives_the_same_bytes_on_any_thread_count() {
     let (ss, sm) = biped(30, 1);
     let (ts, tm) = quadruped(40, 2);
     let map = leg_map(&ss, &ts);
-    let settings = Settings { seed: 9, ..Settings::default() };
+    // A low alpha: with the default 0.85 the bound channels decide nearly every match and the
+    // noise barely matters, so two seeds can agree on a tiny example.
+    let settings = Settings { seed: 9, alpha: 0.3, ..Settings::default() };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| retarget(&sm, &ss, std::slice::from_ref(&tm), &ts, &map, &settings).unwrap().motion)
