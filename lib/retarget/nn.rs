@@ -102,21 +102,6 @@ impl Bank {
     }
 }
 
-/// Four dot products of two query rows with two example rows (2x2 register tile).
-#[inline(always)]
-fn dot2x2(a0: &[f32], a1: &[f32], b0: &[f32], b1: &[f32]) -> [f32; 4] {
-    let (mut s00, mut s01, mut s10, mut s11) = ([0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES]);
-    for (((x0, x1), y0), y1) in a0.chunks_exact(LANES).zip(a1.chunks_exact(LANES)).zip(b0.chunks_exact(LANES)).zip(b1.chunks_exact(LANES)) {
-        for l in 0..LANES {
-            s00[l] += x0[l] * y0[l];
-            s01[l] += x0[l] * y1[l];
-            s10[l] += x1[l] * y0[l];
-            s11[l] += x1[l] * y1[l];
-        }
-    }
-    [hsum(&s00), hsum(&s01), hsum(&s10), hsum(&s11)]
-}
-
 #[inline(always)]
 fn dot(a: &[f32], b: &[f32]) -> f32 {
     let mut s = [0.0f32; LANES];
@@ -133,13 +118,20 @@ fn hsum(s: &[f32; LANES]) -> f32 {
     ((s[0] + s[4]) + (s[1] + s[5])) + ((s[2] + s[6]) + (s[3] + s[7]))
 }
 
-/// `G = A B^T` for `rows` rows of `a` and `cols` rows of `b` (both of `stride` floats).
+fn row(m: &[f32], i: usize, stride: usize) -> &[f32] {
+    &m[i * stride..(i + 1) * stride]
+}
+
+/// `G = A B^T` for `rows` rows of `a` and `cols` rows of `b` (both of `stride` floats, a
+/// multiple of `LANES`).
 ///
-/// On x86-64 CPUs with AVX the same code is compiled a second time with AVX enabled, so the
-/// 8-lane accumulators become single registers (the baseline target has only 4-lane SSE). AVX
-/// without FMA performs exactly the same multiplications and additions in the same order, so
-/// both versions give the same bits.
+/// On x86-64 CPUs with AVX a hand-tiled AVX kernel runs instead (the baseline target has only
+/// SSE, and the compiler does not tile this loop well). It performs exactly the same
+/// multiplications and additions per output (8 lane sums, no FMA, the same final sum), so
+/// both give the same bits and results do not depend on the CPU's features.
 fn gram(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut Vec<f32>) {
+    out.clear();
+    out.resize(rows * cols, 0.0);
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx") {
@@ -148,41 +140,62 @@ fn gram(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut
             return;
         }
     }
-    gram_body(a, rows, b, cols, stride, out);
+    for r in 0..rows {
+        for c in 0..cols {
+            out[r * cols + c] = dot(row(a, r, stride), row(b, c, stride));
+        }
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-fn gram_avx(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut Vec<f32>) {
-    gram_body(a, rows, b, cols, stride, out);
-}
-
-#[inline(always)]
-fn gram_body(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut Vec<f32>) {
-    out.clear();
-    out.resize(rows * cols, 0.0);
-    fn row(m: &[f32], i: usize, stride: usize) -> &[f32] {
-        &m[i * stride..(i + 1) * stride]
-    }
+fn gram_avx(a: &[f32], rows: usize, b: &[f32], cols: usize, stride: usize, out: &mut [f32]) {
+    use std::arch::x86_64::*;
+    // Loads of 8 floats at `k` from a row: k + 8 <= stride = the row's length.
+    let load = |v: &[f32], k: usize| -> __m256 {
+        debug_assert!(k + LANES <= v.len());
+        // SAFETY: in bounds (see above); loadu has no alignment requirement.
+        unsafe { _mm256_loadu_ps(v.as_ptr().add(k)) }
+    };
+    let sum = |v: __m256| -> f32 {
+        let mut lanes = [0.0f32; LANES];
+        // SAFETY: `lanes` holds exactly 8 floats.
+        unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), v) };
+        hsum(&lanes)
+    };
+    // 4 query rows x 2 example rows: 8 accumulators, 2 example loads and 4 query loads per
+    // 64 multiply-adds.
     let mut r = 0;
-    while r + 1 < rows {
-        let (a0, a1) = (row(a, r, stride), row(a, r + 1, stride));
+    while r + 4 <= rows {
+        let q = [row(a, r, stride), row(a, r + 1, stride), row(a, r + 2, stride), row(a, r + 3, stride)];
         let mut c = 0;
-        while c + 1 < cols {
-            let d = dot2x2(a0, a1, row(b, c, stride), row(b, c + 1, stride));
-            out[r * cols + c] = d[0];
-            out[r * cols + c + 1] = d[1];
-            out[(r + 1) * cols + c] = d[2];
-            out[(r + 1) * cols + c + 1] = d[3];
+        while c + 2 <= cols {
+            let (e0, e1) = (row(b, c, stride), row(b, c + 1, stride));
+            let mut acc = [_mm256_setzero_ps(); 8];
+            let mut k = 0;
+            while k + LANES <= stride {
+                let (y0, y1) = (load(e0, k), load(e1, k));
+                for i in 0..4 {
+                    let x = load(q[i], k);
+                    acc[2 * i] = _mm256_add_ps(acc[2 * i], _mm256_mul_ps(x, y0));
+                    acc[2 * i + 1] = _mm256_add_ps(acc[2 * i + 1], _mm256_mul_ps(x, y1));
+                }
+                k += LANES;
+            }
+            for i in 0..4 {
+                out[(r + i) * cols + c] = sum(acc[2 * i]);
+                out[(r + i) * cols + c + 1] = sum(acc[2 * i + 1]);
+            }
             c += 2;
         }
-        if c < cols {
-            out[r * cols + c] = dot(a0, row(b, c, stride));
-            out[(r + 1) * cols + c] = dot(a1, row(b, c, stride));
+        for c in c..cols {
+            for i in 0..4 {
+                out[(r + i) * cols + c] = dot(q[i], row(b, c, stride));
+            }
         }
-        r += 2;
+        r += 4;
     }
-    if r < rows {
+    for r in r..rows {
         for c in 0..cols {
             out[r * cols + c] = dot(row(a, r, stride), row(b, c, stride));
         }
@@ -367,6 +380,21 @@ mod tests {
                 }
                 want /= (p * w) as f32;
                 assert!((out[i * bank.len() + j] - want).abs() < 1e-5, "{i} {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_fast_kernel_gives_the_scalar_bits() {
+        // Sizes that exercise every remainder of the 4x2 tiling.
+        let stride = 24;
+        let a: Vec<f32> = (0..11 * stride).map(|i| ((i * 37 % 101) as f32 * 0.013).sin()).collect();
+        let b: Vec<f32> = (0..7 * stride).map(|i| ((i * 53 % 97) as f32 * 0.029).cos()).collect();
+        let mut g = Vec::new();
+        gram(&a, 11, &b, 7, stride, &mut g);
+        for r in 0..11 {
+            for c in 0..7 {
+                assert_eq!(g[r * 7 + c].to_bits(), dot(row(&a, r, stride), row(&b, c, stride)).to_bits(), "{r} {c}");
             }
         }
     }
