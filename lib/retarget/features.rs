@@ -12,9 +12,9 @@
 use super::settings::Repr;
 use crate::motion::Motion;
 use crate::repr::m2m;
-use crate::repr::Features;
 use crate::skeleton::Skeleton;
 use glam::{DQuat, DVec3};
+use rayon::prelude::*;
 
 /// A `[frames, width]` float32 array, frame-major: one channel vector per frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -193,22 +193,34 @@ pub(crate) fn point_features(motion: &Motion, skeleton: &Skeleton, repr: Repr, s
     out
 }
 
-/// Decode rotation features on `skeleton`: 6D rotations, root velocities summed from `start`.
+/// Decode rotation features on `skeleton`: 6D rotations (`m2m`'s convention, in parallel over
+/// frames), root velocities summed from `start`, other translations from the OFFSETs.
 pub(crate) fn decode(rot: &Channels, skeleton: &Skeleton, scale: f64, start: (f64, f64), frame_time: f64) -> Result<Motion, m2m::M2mError> {
     let j = skeleton.len();
-    let mut features = Features::zeros(rot.frames, j, m2m::DIMS);
-    for f in 0..rot.frames {
-        let row = rot.row(f);
-        for k in 0..j {
-            features.at_mut(f, k)[m2m::ROTATION].copy_from_slice(&row[6 * k..6 * k + 6]);
-        }
-        let r = &row[6 * j..6 * j + 3];
-        let (dx, dz) = if f == 0 { (start.0, start.1) } else { (r[0] as f64 / scale, r[2] as f64 / scale) };
-        features.at_mut(f, 0)[m2m::ROOT_POSITION].copy_from_slice(&[dx as f32, (r[1] as f64 / scale) as f32, dz as f32]);
+    if let Some(k) = rot.data.iter().position(|v| !v.is_finite()) {
+        let (frame, c) = (k / rot.width, k % rot.width);
+        let (joint, dim) = if c < 6 * j { (c / 6, c % 6) } else { (0, c - 6 * j + 6) };
+        return Err(m2m::M2mError::NonFinite { frame, joint, name: skeleton.joints[joint].name.clone(), dim, value: rot.data[k] });
     }
-    let mut motion = m2m::decode(&features, skeleton)?;
-    motion.frame_time = frame_time;
-    Ok(motion)
+    let rotations: Vec<DQuat> = (0..rot.frames)
+        .into_par_iter()
+        .flat_map_iter(|f| {
+            let row = rot.row(f);
+            (0..j).map(move |k| m2m::rotation_from_6d(std::array::from_fn(|i| row[6 * k + i] as f64)))
+        })
+        .collect();
+    let mut translations = Vec::with_capacity(rot.frames * j);
+    let (mut x, mut z) = start;
+    for f in 0..rot.frames {
+        let r = &rot.row(f)[6 * j..6 * j + 3];
+        if f > 0 {
+            x += r[0] as f64 / scale;
+            z += r[2] as f64 / scale;
+        }
+        translations.push(DVec3::new(x, r[1] as f64 / scale, z));
+        translations.extend(skeleton.joints.iter().skip(1).map(|joint| joint.offset));
+    }
+    Ok(Motion { frames: rot.frames, joints: j, frame_time, rotations, translations })
 }
 
 /// Rest direction of a joint's bone: towards its first child, else its first End Site.

@@ -18,8 +18,8 @@
 //!   channels start from the source interpolated (better than noise) and are then free.
 //! * Bound rotations can be rest-aligned or root-relative world copies (`BoundRotation`), and
 //!   the root trajectory can come from the source scaled to the target's size (`RootMotion`).
-//! * Determinism: a seed gives the same bytes whatever the thread count (noise is drawn from
-//!   one sequential stream, every parallel reduction has a fixed order).
+//! * Determinism: a seed gives the same bytes whatever the thread count (each frame's noise has
+//!   its own stream derived from the seed, every parallel reduction has a fixed order).
 //!
 //! Frame rates are the caller's business: `resample` brings the source to the examples' rate.
 
@@ -394,18 +394,23 @@ impl<'a> Plan<'a> {
         let (cm, cp) = level_clips(first);
         let mut state_m = concat(&cm).resize(first);
         let mut state_p = concat(&cp).resize(first);
-        // Bound channels are about to be overwritten by the source: they get no noise.
-        let mut gauss = noise::Gaussian::new(seed);
-        for (c, mask) in [(&mut state_m, &self.mask.0), (&mut state_p, &self.mask.1)] {
+        // Bound channels are about to be overwritten by the source: they get no noise. Each
+        // frame draws from its own stream (seeded by the seed and the frame), so frames can be
+        // filled in parallel with the same values on any thread count.
+        for (stream, (c, mask)) in [(&mut state_m, &self.mask.0), (&mut state_p, &self.mask.1)].into_iter().enumerate() {
             let free: Vec<usize> = (0..c.width).filter(|&k| !mask[k]).collect();
-            for t in 0..c.frames {
-                let row = c.row_mut(t);
+            if c.width == 0 {
+                continue;
+            }
+            let stream = stream as u64;
+            c.data.par_chunks_mut(c.width).enumerate().for_each(|(t, row)| {
+                let mut gauss = noise::Gaussian::new(noise::stream_seed(seed, stream, t as u64));
                 for &k in &free {
                     let x = row[k] as f64 + s.noise_sigma * gauss.next();
                     // fmod(x, 1) as the reference, without the slow library call.
                     row[k] = (x - x.trunc()) as f32;
                 }
-            }
+            });
         }
         // Bound channels start from the source everywhere (interpolated between key frames).
         let ones = vec![1.0f32; first];

@@ -328,12 +328,30 @@ fn blend(choice: &[(usize, usize)], clips: &[Channels], frames: usize, p: usize)
     out.data.par_chunks_mut(width).enumerate().for_each(|(t, row)| {
         let lo = t.saturating_sub(p - 1);
         let hi = t.min(choice.len().saturating_sub(1));
-        let mut n = 0usize;
+        // Where the chosen patches are coherent (patch i + 1 continues patch i) they all put
+        // the same example frame here: add each distinct frame once, times its count.
+        let mut sources: [(usize, usize, f32); 64] = [(0, 0, 0.0); 64];
+        let (mut distinct, mut n) = (0usize, 0usize);
         for (i, &(k, b)) in choice.iter().enumerate().take(hi + 1).skip(lo) {
-            for (o, &v) in row.iter_mut().zip(clips[k].row(b + t - i)) {
-                *o += v;
-            }
+            let frame = (k, b + t - i);
             n += 1;
+            if distinct > 0 && (sources[distinct - 1].0, sources[distinct - 1].1) == frame {
+                sources[distinct - 1].2 += 1.0;
+            } else if distinct < sources.len() {
+                sources[distinct] = (frame.0, frame.1, 1.0);
+                distinct += 1;
+            } else {
+                // More distinct frames than the buffer holds (patches over 64 frames): add
+                // directly.
+                for (o, &v) in row.iter_mut().zip(clips[frame.0].row(frame.1)) {
+                    *o += v;
+                }
+            }
+        }
+        for &(k, f, count) in &sources[..distinct] {
+            for (o, &v) in row.iter_mut().zip(clips[k].row(f)) {
+                *o += count * v;
+            }
         }
         if n > 0 {
             let inv = 1.0 / n as f32;

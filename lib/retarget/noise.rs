@@ -1,8 +1,17 @@
 //! Seeded Gaussian noise for the initial synthesis. The generator is the project's own
 //! splitmix64 (`synth::SplitMix64`), so outputs never change because a dependency did; values
-//! are drawn sequentially from one stream, so they do not depend on the thread count.
+//! are drawn from streams derived from the seed and the frame (`stream_seed`), so they do not
+//! depend on the thread count.
 
 use crate::synth::SplitMix64;
+
+/// The seed of one of many independent streams derived from a run's seed (splitmix64's
+/// finaliser over the three numbers, so nearby seeds, streams and frames do not correlate).
+pub(crate) fn stream_seed(seed: u64, stream: u64, index: u64) -> u64 {
+    let mut rng = SplitMix64::new(seed ^ stream.wrapping_mul(0xd1b5_4a32_d192_ed03));
+    let a = rng.next_u64();
+    SplitMix64::new(a ^ index.wrapping_mul(0x9e37_79b9_7f4a_7c15)).next_u64()
+}
 
 pub(crate) struct Gaussian {
     rng: SplitMix64,
