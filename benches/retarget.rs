@@ -115,13 +115,25 @@ fn main() {
         ("4 example clips", 1, 4, &ref_settings),
         ("16 example clips", 1, 16, &ref_settings),
     ];
+    let mut breakdown = Vec::new();
     for (label, k, clips, settings) in rows {
         let source = repeat(&case.source, k);
         let examples = vec![case.example.clone(); clips];
-        let levels = retarget(&source, &case.source_skeleton, &examples, &case.target, &case.map, settings).unwrap().report.levels.iter().map(|l| l.frames.to_string()).collect::<Vec<_>>().join(", ");
+        let report = retarget(&source, &case.source_skeleton, &examples, &case.target, &case.map, settings).unwrap().report;
+        let levels = report.levels.iter().map(|l| l.frames.to_string()).collect::<Vec<_>>().join(", ");
+        let t = &report.timings;
+        breakdown.push(format!("| {label} | {:.2} | {:.2} | {:.2} | {:.2} |", ms(t.prepare), ms(t.synthesis), ms(t.decode), ms(t.total)));
         let one = time(&case, &source, &examples, settings, 1);
         let all = time(&case, &source, &examples, settings, threads);
         println!("| {label} | {} | {clips} ({}) | {levels} | {one:.2} | {all:.2} | {:.0} |", source.frames, clips * case.example.frames, source.frames as f64 / all * 1e3);
+    }
+    println!();
+    println!("One run's own timings ({threads} threads, from the report), ms:");
+    println!();
+    println!("| case | prepare | synthesis | decode | total |");
+    println!("|---|---:|---:|---:|---:|");
+    for line in breakdown {
+        println!("{line}");
     }
     compare_with_reference(&case);
 }

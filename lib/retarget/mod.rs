@@ -403,12 +403,14 @@ impl<'a> Plan<'a> {
                 continue;
             }
             let stream = stream as u64;
+            let sigma = s.noise_sigma as f32;
             c.data.par_chunks_mut(c.width).enumerate().for_each(|(t, row)| {
                 let mut gauss = noise::Gaussian::new(noise::stream_seed(seed, stream, t as u64));
                 for &k in &free {
-                    let x = row[k] as f64 + s.noise_sigma * gauss.next();
-                    // fmod(x, 1) as the reference, without the slow library call.
-                    row[k] = (x - x.trunc()) as f32;
+                    let x = row[k] + sigma * gauss.next();
+                    // fmod(x, 1) as the reference. The integer cast truncates like fmod without
+                    // a library call; |x| is far below i64's range (sigma is at most 1e6).
+                    row[k] = x - (x as i64) as f32;
                 }
             });
         }

@@ -121,8 +121,8 @@ impl Settings {
                 return bad("completeness", c.to_string(), "a positive number");
             }
         }
-        if !(self.noise_sigma.is_finite() && self.noise_sigma >= 0.0) {
-            return bad("noise_sigma", self.noise_sigma.to_string(), "a finite number >= 0");
+        if !(self.noise_sigma.is_finite() && (0.0..=1e6).contains(&self.noise_sigma)) {
+            return bad("noise_sigma", self.noise_sigma.to_string(), "a number in [0, 1e6]");
         }
         if self.frames == Some(0) {
             return Err(RetargetError::ZeroFrames { what: "the requested output".into() });
