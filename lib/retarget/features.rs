@@ -206,7 +206,7 @@ pub(crate) fn decode(rot: &Channels, skeleton: &Skeleton, scale: f64, start: (f6
         .into_par_iter()
         .flat_map_iter(|f| {
             let row = rot.row(f);
-            (0..j).map(move |k| m2m::rotation_from_6d(std::array::from_fn(|i| row[6 * k + i] as f64)))
+            (0..j).map(move |k| quat_from_6d(&row[6 * k..6 * k + 6]))
         })
         .collect();
     let mut translations = Vec::with_capacity(rot.frames * j);
@@ -223,6 +223,40 @@ pub(crate) fn decode(rot: &Channels, skeleton: &Skeleton, scale: f64, start: (f6
     Ok(Motion { frames: rot.frames, joints: j, frame_time, rotations, translations })
 }
 
+/// `m2m::rotation_from_6d` without the detours (the hot loop of decoding long outputs): the
+/// rows are orthonormalised by Gram-Schmidt and the matrix turned into a quaternion (Shepperd's
+/// method, largest diagonal first). Degenerate rows fall back to `m2m`'s careful version.
+pub(crate) fn quat_from_6d(v: &[f32]) -> DQuat {
+    let a = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+    let b = DVec3::new(v[3] as f64, v[4] as f64, v[5] as f64);
+    let la = a.length();
+    let x = a / la;
+    let b = b - x * x.dot(b);
+    let lb = b.length();
+    if !(la > 1e-12 && lb > 1e-12 && la.is_finite() && lb.is_finite()) {
+        return m2m::rotation_from_6d(std::array::from_fn(|i| v[i] as f64));
+    }
+    let y = b / lb;
+    let z = x.cross(y);
+    // x, y, z are the rows of R.
+    let (m00, m01, m02, m10, m11, m12, m20, m21, m22) = (x.x, x.y, x.z, y.x, y.y, y.z, z.x, z.y, z.z);
+    let trace = m00 + m11 + m22;
+    let q = if trace > 0.0 {
+        let s = (trace + 1.0).sqrt() * 2.0;
+        DQuat::from_xyzw((m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, 0.25 * s)
+    } else if m00 > m11 && m00 > m22 {
+        let s = (1.0 + m00 - m11 - m22).sqrt() * 2.0;
+        DQuat::from_xyzw(0.25 * s, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s)
+    } else if m11 > m22 {
+        let s = (1.0 + m11 - m00 - m22).sqrt() * 2.0;
+        DQuat::from_xyzw((m01 + m10) / s, 0.25 * s, (m12 + m21) / s, (m02 - m20) / s)
+    } else {
+        let s = (1.0 + m22 - m00 - m11).sqrt() * 2.0;
+        DQuat::from_xyzw((m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s)
+    };
+    q.normalize()
+}
+
 /// Rest direction of a joint's bone: towards its first child, else its first End Site.
 pub(crate) fn bone_direction(skeleton: &Skeleton, joint: usize) -> Option<DVec3> {
     let child = skeleton.joints.iter().find(|c| c.parent == Some(joint)).map(|c| c.offset);
@@ -235,5 +269,31 @@ pub(crate) fn alignment(source: &Skeleton, s: usize, target: &Skeleton, t: usize
     match (bone_direction(source, s), bone_direction(target, t)) {
         (Some(ds), Some(dt)) => DQuat::from_rotation_arc(dt, ds),
         _ => DQuat::IDENTITY,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_6d_decoding_agrees_with_m2m() {
+        let qs = [
+            DQuat::IDENTITY,
+            DQuat::from_rotation_x(3.1),
+            DQuat::from_rotation_y(-2.9),
+            DQuat::from_rotation_z(3.0),
+            DQuat::from_euler(glam::EulerRot::ZXY, 0.3, -1.2, 2.2),
+            DQuat::from_euler(glam::EulerRot::XYZ, 2.8, 0.1, -2.9),
+        ];
+        for q in qs {
+            let six: Vec<f32> = m2m::rotation_to_6d(q).iter().map(|&v| v as f32 * 1.7).collect();
+            let (fast, slow) = (quat_from_6d(&six), m2m::rotation_from_6d(std::array::from_fn(|i| six[i] as f64)));
+            assert!(fast.dot(slow).abs() > 1.0 - 1e-9, "{q}: {fast} vs {slow}");
+            assert!(fast.dot(q).abs() > 1.0 - 1e-6);
+        }
+        // Degenerate rows still give a rotation.
+        assert!(quat_from_6d(&[0.0; 6]).is_normalized());
+        assert!(quat_from_6d(&[1.0, 0.0, 0.0, 2.0, 0.0, 0.0]).is_normalized());
     }
 }

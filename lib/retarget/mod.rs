@@ -458,8 +458,18 @@ impl<'a> Plan<'a> {
     /// Set the bound channels of a `len`-frame synthesis from the source, frame t weighted by
     /// `known[t]` (1: the source's value, 0: keep the synthesis).
     fn project(&self, state_m: &mut Channels, state_p: &mut Channels, len: usize, known: &[f32]) {
-        let src_m = self.source.0.resize(len);
-        let src_p = self.source.1.resize(len);
+        // Only resample the source when something reads it (it is as wide as the synthesis).
+        let world = !self.world.is_empty();
+        let resized = |c: &Channels, mask: &[bool], rotations: bool| {
+            if mask.iter().any(|&b| b) || (world && rotations) {
+                c.resize(len)
+            } else {
+                Channels::zeros(0, c.width)
+            }
+        };
+        let points = state_p.width > 0;
+        let src_m = resized(&self.source.0, &self.mask.0, !points);
+        let src_p = resized(&self.source.1, &self.mask.1, points);
         for (state, src, mask) in [(&mut *state_m, &src_m, &self.mask.0), (&mut *state_p, &src_p, &self.mask.1)] {
             let bound: Vec<usize> = (0..mask.len()).filter(|&c| mask[c]).collect();
             if bound.is_empty() {
@@ -580,17 +590,19 @@ fn spread(src: &Channels, key: &[usize], frames: usize) -> Channels {
         while next < key.len() && key[next] < t {
             next += 1;
         }
-        let row: Vec<f32> = match (next.checked_sub(1).map(|i| key[i]), key.get(next).copied()) {
-            (_, Some(b)) if b == t => src.row(b).to_vec(),
+        let dst = out.row_mut(t);
+        match (next.checked_sub(1).map(|i| key[i]), key.get(next).copied()) {
+            (_, Some(b)) if b == t => dst.copy_from_slice(src.row(b)),
             (Some(a), Some(b)) => {
                 let w = (t - a) as f32 / (b - a) as f32;
-                src.row(a).iter().zip(src.row(b)).map(|(x, y)| x + (y - x) * w).collect()
+                for ((d, x), y) in dst.iter_mut().zip(src.row(a)).zip(src.row(b)) {
+                    *d = x + (y - x) * w;
+                }
             }
-            (Some(a), None) => src.row(a).to_vec(),
-            (None, Some(b)) => src.row(b).to_vec(),
-            (None, None) => vec![0.0; src.width],
-        };
-        out.row_mut(t).copy_from_slice(&row);
+            (Some(a), None) => dst.copy_from_slice(src.row(a)),
+            (None, Some(b)) => dst.copy_from_slice(src.row(b)),
+            (None, None) => {}
+        }
     }
     out
 }
