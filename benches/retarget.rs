@@ -81,6 +81,30 @@ fn repeat(m: &Motion, k: usize) -> Motion {
     out
 }
 
+/// On-CPU time of the calling thread (Linux `schedstat`), in ms: on a machine shared with other
+/// jobs, wall time counts the waits for a core; this does not.
+fn thread_cpu_ms() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(text.split_whitespace().next()?.parse::<f64>().ok()? / 1e6)
+}
+
+/// Median on-CPU ms of `retarget` on one thread (`None` without schedstat).
+fn cpu_time(case: &Case, source: &Motion, examples: &[Motion], settings: &Settings) -> Option<f64> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    pool.install(|| {
+        let run = || black_box(retarget(source, &case.source_skeleton, examples, &case.target, &case.map, settings).unwrap());
+        run();
+        let mut t: Vec<f64> = Vec::new();
+        for _ in 0..RUNS {
+            let start = thread_cpu_ms()?;
+            run();
+            t.push(thread_cpu_ms()? - start);
+        }
+        t.sort_by(f64::total_cmp);
+        Some(t[t.len() / 2])
+    })
+}
+
 fn time(case: &Case, source: &Motion, examples: &[Motion], settings: &Settings, threads: usize) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| {
@@ -105,8 +129,8 @@ fn main() {
     let paper = Settings::default();
     println!("{name}: source {} frames x {} joints, example {} frames x {} joints, {} bound bones; {RUNS} runs, median ms", case.source.frames, case.source.joints, case.example.frames, case.example.joints, case.map.len());
     println!();
-    println!("| case | source frames | example clips (frames) | levels | 1 thread ms | {threads} threads ms | frames/s ({threads} thr) |");
-    println!("|---|---:|---:|---|---:|---:|---:|");
+    println!("| case | source frames | example clips (frames) | levels | 1 thread ms | 1 thread on-CPU ms | {threads} threads ms | frames/s ({threads} thr) |");
+    println!("|---|---:|---:|---|---:|---:|---:|---:|");
     let rows: Vec<(&str, usize, usize, &Settings)> = vec![
         ("demo, alpha 0.9 (reference demo)", 1, 1, &ref_settings),
         ("demo, paper defaults", 1, 1, &paper),
@@ -124,8 +148,9 @@ fn main() {
         let t = &report.timings;
         breakdown.push(format!("| {label} | {:.2} | {:.2} | {:.2} | {:.2} |", ms(t.prepare), ms(t.synthesis), ms(t.decode), ms(t.total)));
         let one = time(&case, &source, &examples, settings, 1);
+        let cpu = cpu_time(&case, &source, &examples, settings).map(|c| format!("{c:.2}")).unwrap_or_else(|| "-".into());
         let all = time(&case, &source, &examples, settings, threads);
-        println!("| {label} | {} | {clips} ({}) | {levels} | {one:.2} | {all:.2} | {:.0} |", source.frames, clips * case.example.frames, source.frames as f64 / all * 1e3);
+        println!("| {label} | {} | {clips} ({}) | {levels} | {one:.2} | {cpu} | {all:.2} | {:.0} |", source.frames, clips * case.example.frames, source.frames as f64 / all * 1e3);
     }
     println!();
     println!("One run's own timings ({threads} threads, from the report), ms:");
