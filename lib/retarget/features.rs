@@ -229,32 +229,40 @@ pub(crate) fn decode(rot: &Channels, skeleton: &Skeleton, scale: f64, start: (f6
 pub(crate) fn quat_from_6d(v: &[f32]) -> DQuat {
     let a = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
     let b = DVec3::new(v[3] as f64, v[4] as f64, v[5] as f64);
+    // Reciprocals and products instead of divisions: this loop is bound by the latency of
+    // its chain of square roots and divisions.
     let la = a.length();
-    let x = a / la;
+    let x = a * (1.0 / la);
     let b = b - x * x.dot(b);
     let lb = b.length();
     if !(la > 1e-12 && lb > 1e-12 && la.is_finite() && lb.is_finite()) {
         return m2m::rotation_from_6d(std::array::from_fn(|i| v[i] as f64));
     }
-    let y = b / lb;
+    let y = b * (1.0 / lb);
     let z = x.cross(y);
     // x, y, z are the rows of R.
     let (m00, m01, m02, m10, m11, m12, m20, m21, m22) = (x.x, x.y, x.z, y.x, y.y, y.z, z.x, z.y, z.z);
     let trace = m00 + m11 + m22;
     let q = if trace > 0.0 {
         let s = (trace + 1.0).sqrt() * 2.0;
-        DQuat::from_xyzw((m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, 0.25 * s)
+        let r = 1.0 / s;
+        DQuat::from_xyzw((m21 - m12) * r, (m02 - m20) * r, (m10 - m01) * r, 0.25 * s)
     } else if m00 > m11 && m00 > m22 {
         let s = (1.0 + m00 - m11 - m22).sqrt() * 2.0;
-        DQuat::from_xyzw(0.25 * s, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s)
+        let r = 1.0 / s;
+        DQuat::from_xyzw(0.25 * s, (m01 + m10) * r, (m02 + m20) * r, (m21 - m12) * r)
     } else if m11 > m22 {
         let s = (1.0 + m11 - m00 - m22).sqrt() * 2.0;
-        DQuat::from_xyzw((m01 + m10) / s, 0.25 * s, (m12 + m21) / s, (m02 - m20) / s)
+        let r = 1.0 / s;
+        DQuat::from_xyzw((m01 + m10) * r, 0.25 * s, (m12 + m21) * r, (m02 - m20) * r)
     } else {
         let s = (1.0 + m22 - m00 - m11).sqrt() * 2.0;
-        DQuat::from_xyzw((m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s)
+        let r = 1.0 / s;
+        DQuat::from_xyzw((m02 + m20) * r, (m12 + m21) * r, 0.25 * s, (m10 - m01) * r)
     };
-    q.normalize()
+    // The matrix is orthonormal to rounding, so the quaternion is unit to rounding; one
+    // multiply by the reciprocal length makes it exact enough for `is_normalized`.
+    q * (1.0 / q.length())
 }
 
 /// Rest direction of a joint's bone: towards its first child, else its first End Site.

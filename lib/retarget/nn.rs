@@ -47,16 +47,14 @@ fn padded(width: usize) -> usize {
 
 /// Weighted, zero-padded copy of `c` (frame-major, rows of `stride`), with each frame's norm.
 fn weigh(c: &Channels, weights: &[f32], stride: usize) -> (Vec<f32>, Vec<f32>) {
-    let mut out = vec![0.0f32; c.frames * stride];
+    // Built by extending rather than zeroing first: this runs on the whole synthesis every step.
+    let mut out = Vec::with_capacity(c.frames * stride);
     let mut norms = Vec::with_capacity(c.frames);
     for t in 0..c.frames {
-        let dst = &mut out[t * stride..t * stride + c.width];
-        let mut n = 0.0f32;
-        for ((d, &v), &w) in dst.iter_mut().zip(c.row(t)).zip(weights) {
-            *d = v * w;
-            n += *d * *d;
-        }
-        norms.push(n);
+        let start = out.len();
+        out.extend(c.row(t).iter().zip(weights).map(|(&v, &w)| v * w));
+        out.resize(start + stride, 0.0);
+        norms.push(out[start..].iter().map(|d| d * d).sum());
     }
     (out, norms)
 }
