@@ -13,5 +13,6 @@ pub mod metrics;
 pub mod motion;
 pub mod render;
 pub mod repr;
+pub mod retarget;
 pub mod skeleton;
 pub mod synth;
