@@ -11,6 +11,7 @@ pub mod load;
 pub mod mo_encode;
 pub mod mo_metrics;
 pub mod mo_render;
+pub mod mo_retarget;
 pub mod skel_aug;
 pub mod skel_info;
 
@@ -72,6 +73,7 @@ pub fn all_commands() -> Vec<clap::Command> {
         skel_info::Args::command(),
         skel_aug::Args::command(),
         mo_encode::Args::command(),
+        mo_retarget::Args::command(),
         // mo-render and mo-metrics join here (and get man pages, completions and a tested
         // EXAMPLES block) when they stop being stubs.
     ]

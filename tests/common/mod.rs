@@ -60,6 +60,7 @@ pub fn bin(name: &str) -> Command {
         "mo-encode" => env!("CARGO_BIN_EXE_mo-encode"),
         "mo-render" => env!("CARGO_BIN_EXE_mo-render"),
         "mo-metrics" => env!("CARGO_BIN_EXE_mo-metrics"),
+        "mo-retarget" => env!("CARGO_BIN_EXE_mo-retarget"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);

@@ -1,0 +1,29 @@
+complete -c mo-retarget -l bind -d 'Binding JSON file, or \'auto\'' -r
+complete -c mo-retarget -l bind-rate -d 'Binding rate of --bind auto: 2 x pairs / (source joints + target joints)' -r
+complete -c mo-retarget -s n -l samples -d 'Number of diverse samples' -r
+complete -c mo-retarget -l frames -d 'Output length in frames [default: the source\'s, after resampling]' -r
+complete -c mo-retarget -l seconds -d 'Output length in seconds' -r
+complete -c mo-retarget -l key-frames -d 'Key-frame mode: the source counts only at these frames (comma-separated, source frames)' -r
+complete -c mo-retarget -l format -d 'Output format' -r -f -a "bvh\t''
+npy\t''"
+complete -c mo-retarget -l patch -d 'Patch length in frames (paper: 11)' -r
+complete -c mo-retarget -l alpha -d 'Weight of the bound (source) channels in matching, 0..1 (paper: 0.85)' -r
+complete -c mo-retarget -l steps -d 'Match-and-blend iterations per pyramid level (paper: 3)' -r
+complete -c mo-retarget -l pyramid -d 'Scale between pyramid levels (paper: 0.75)' -r
+complete -c mo-retarget -l repr -d 'Matching features (paper table 4)' -r -f -a "rotation\t''
+velocity\t''
+position\t''"
+complete -c mo-retarget -l bound-rotation -d 'How bound joints take the source\'s rotation' -r -f -a "local\t'Copy the source\'s local rotations (the reference\'s behaviour)'
+aligned\t'Rotate bound bones so their directions follow the source\'s, relative to each rest pose'
+world\t'Match the source\'s world rotations'"
+complete -c mo-retarget -l root-motion -d 'Where the root trajectory comes from' -r -f -a "examples\t'From the examples\' patches (the reference\'s behaviour)'
+source\t'The source\'s trajectory, scaled to the target\'s size'"
+complete -c mo-retarget -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
+complete -c mo-retarget -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
+complete -c mo-retarget -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-retarget -l emit-binding -d 'Print the binding (JSON) and stop'
+complete -c mo-retarget -l report -d 'Print timing, binding, pyramid levels and per-level match cost on stderr'
+complete -c mo-retarget -s q -l quiet -d 'Print nothing on stderr but errors'
+complete -c mo-retarget -s v -l verbose -d 'Print more about what is happening on stderr'
+complete -c mo-retarget -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mo-retarget -s V -l version -d 'Print version'

@@ -1,0 +1,421 @@
+//! `mo-retarget`: cross-topology motion transfer (Motion2Motion). This file reads the source
+//! and the target's example clips, resolves or computes the binding, matches frame rates,
+//! calls `retarget::retarget_samples`, and writes BVH (or NPY) on the target skeleton. All
+//! outputs are built in memory first, so a failure never leaves some files written.
+
+use crate::binding::auto::{self, AutoOptions, Body};
+use crate::binding::{Binding, JointMap};
+use crate::cli::load::{expand_inputs, is_dash};
+use crate::cli::CommonOpts;
+use crate::document::AnyTopSection;
+use crate::io::{self, npy};
+use crate::motion::Motion;
+use crate::repr::anytop::AnyTopOptions;
+use crate::repr::m2m;
+use crate::retarget::{self, BoundRotation, Repr, RootMotion, Settings};
+use crate::skeleton::Skeleton;
+use crate::bvh;
+use anyhow::{bail, Context};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+const EXAMPLES: &str = "\
+EXAMPLES:
+    mo-retarget examples/data/biped.bvh examples/data/quadruped.bvh --bind auto -o quad.bvh
+    mo-retarget examples/data/biped.bvh examples/data/quadruped.bvh --bind auto --emit-binding
+    mo-retarget examples/data/quadruped.bvh examples/data/dragon.bvh --bind auto -n 3 -o 'd_{i}.bvh'
+    mo-retarget examples/data/biped.bvh examples/data/biped.bvh --bind auto --seconds 2 -o b.bvh
+    cat examples/data/spider.bvh | mo-retarget - examples/data/crab.bvh --bind auto --format npy";
+
+/// Transfer a motion to a different skeleton from a few example clips of it (Motion2Motion).
+///
+/// SOURCE is a BVH (path or '-'); TARGETS are example clips of the target skeleton (BVH files
+/// or directories of them; all must share one skeleton). No training: the result is stitched
+/// from patches of the examples, chosen coarse-to-fine so that the bound joints follow the
+/// source and everything else moves like the examples do.
+///
+/// Binding: --bind FILE reads pairs source joint -> target joint (our JSON or the reference's
+/// {\"mapping\": [{\"source\", \"target\"}]}); names match exactly, by case, without namespace
+/// or by normalised name, never by substring. --bind auto computes a sparse binding (chain
+/// bone directions as in the paper's appendix A, plus body place, sides, feet and names) at
+/// --bind-rate (the paper's 6.1%); --emit-binding prints it as JSON to inspect, edit and
+/// reuse instead of retargeting.
+///
+/// Frame rates: the source is resampled to the examples' rate when they differ (said on
+/// stderr). Output length: the source's, or --frames / --seconds. --key-frames makes the
+/// source count only at those frames; the rest is synthesised.
+///
+/// Output: BVH on the target skeleton with its channel orders and End Sites (default), or
+/// --format npy (Motion2Motion features [frames, joints, 9], or [n, frames, joints, 9] for -n).
+/// -n K writes K diverse samples (seeds --seed .. --seed+K-1) to -o PATTERN with '{i}'.
+/// --report prints timing, the binding, pyramid levels and per-level match cost on stderr.
+#[derive(clap::Parser, Debug)]
+#[command(name = "mo-retarget", version, after_long_help = EXAMPLES)]
+pub struct Args {
+    /// The motion to transfer: a BVH file ('-' = stdin).
+    #[arg(value_name = "SOURCE")]
+    pub source: PathBuf,
+    /// Example clips of the target skeleton: BVH files or directories.
+    #[arg(value_name = "TARGETS", required = true, num_args = 1..)]
+    pub targets: Vec<PathBuf>,
+    /// Binding JSON file, or 'auto'.
+    #[arg(long, value_name = "FILE|auto")]
+    pub bind: String,
+    /// Binding rate of --bind auto: 2 x pairs / (source joints + target joints).
+    #[arg(long, value_name = "R", default_value_t = 0.061)]
+    pub bind_rate: f64,
+    /// Print the binding (JSON) and stop.
+    #[arg(long)]
+    pub emit_binding: bool,
+    /// Number of diverse samples.
+    #[arg(short = 'n', long = "samples", value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub samples: u64,
+    /// Output length in frames [default: the source's, after resampling].
+    #[arg(long, value_name = "N", conflicts_with = "seconds")]
+    pub frames: Option<usize>,
+    /// Output length in seconds.
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Key-frame mode: the source counts only at these frames (comma-separated, source frames).
+    #[arg(long, value_name = "F,F,...", value_delimiter = ',')]
+    pub key_frames: Option<Vec<usize>>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = OutFormat::Bvh)]
+    pub format: OutFormat,
+    /// Patch length in frames (paper: 11).
+    #[arg(long, value_name = "FRAMES")]
+    pub patch: Option<usize>,
+    /// Weight of the bound (source) channels in matching, 0..1 (paper: 0.85).
+    #[arg(long, value_name = "A")]
+    pub alpha: Option<f64>,
+    /// Match-and-blend iterations per pyramid level (paper: 3).
+    #[arg(long, value_name = "L")]
+    pub steps: Option<usize>,
+    /// Scale between pyramid levels (paper: 0.75).
+    #[arg(long, value_name = "S")]
+    pub pyramid: Option<f64>,
+    /// Matching features (paper table 4).
+    #[arg(long, value_enum)]
+    pub repr: Option<ReprArg>,
+    /// How bound joints take the source's rotation.
+    #[arg(long, value_enum)]
+    pub bound_rotation: Option<BoundArg>,
+    /// Where the root trajectory comes from.
+    #[arg(long, value_enum)]
+    pub root_motion: Option<RootArg>,
+    /// Print timing, binding, pyramid levels and per-level match cost on stderr.
+    #[arg(long)]
+    pub report: bool,
+    #[command(flatten)]
+    pub common: CommonOpts,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutFormat {
+    Bvh,
+    Npy,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReprArg {
+    Rotation,
+    Velocity,
+    Position,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoundArg {
+    /// Copy the source's local rotations (the reference's behaviour).
+    Local,
+    /// Rotate bound bones so their directions follow the source's, relative to each rest pose.
+    Aligned,
+    /// Match the source's world rotations.
+    World,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RootArg {
+    /// From the examples' patches (the reference's behaviour).
+    Examples,
+    /// The source's trajectory, scaled to the target's size.
+    Source,
+}
+
+/// One read clip.
+struct Clip {
+    name: String,
+    skeleton: Skeleton,
+    motion: Motion,
+}
+
+fn read_clip(path: &Path) -> anyhow::Result<Clip> {
+    let name = io::display_name(path);
+    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    if bytes.starts_with(b"\x93NUMPY") {
+        bail!("{name}: mo-retarget reads BVH files (decode features first: mo-encode --decode)");
+    }
+    let parsed = bvh::parse_bytes(&bytes, &name)?;
+    let skeleton = Skeleton::from_bvh(&parsed);
+    skeleton.validate().with_context(|| name.clone())?;
+    let motion = Motion::from_bvh(&parsed, &skeleton);
+    Ok(Clip { name, skeleton, motion })
+}
+
+/// Same tree and names (the examples must be clips of one skeleton).
+fn same_skeleton(a: &Clip, b: &Clip) -> anyhow::Result<()> {
+    if a.skeleton.len() != b.skeleton.len() {
+        bail!("{} has {} joints but {} has {}: all target clips must share one skeleton", b.name, b.skeleton.len(), a.name, a.skeleton.len());
+    }
+    for (j, (x, y)) in a.skeleton.joints.iter().zip(&b.skeleton.joints).enumerate() {
+        if x.parent != y.parent || x.name != y.name {
+            bail!("{}: joint {j} is '{}' but {} has '{}' there: all target clips must share one skeleton", b.name, y.name, a.name, x.name);
+        }
+    }
+    Ok(())
+}
+
+/// The AnyTop rig's natural rest pose: faces +z, so two creatures compare in one frame.
+fn canonical_rest(c: &Clip) -> anyhow::Result<Vec<glam::DVec3>> {
+    let section = AnyTopSection::new(&c.skeleton, &c.motion.first_frames(2), &AnyTopOptions::default())
+        .with_context(|| format!("{}: cannot find its rest pose and facing", c.name))?;
+    Ok(section.rig.rest_positions(&c.skeleton))
+}
+
+fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Settings> {
+    let mut s = Settings { seed: args.common.seed, ..Settings::default() };
+    if let Some(p) = args.patch {
+        if p < 1 {
+            bail!("--patch must be at least 1 frame");
+        }
+        s.patch = p;
+    }
+    if let Some(a) = args.alpha {
+        if !(0.0..=1.0).contains(&a) {
+            bail!("--alpha must be within 0..1, found {a}");
+        }
+        s.alpha = a as f32;
+    }
+    if let Some(l) = args.steps {
+        if l < 1 {
+            bail!("--steps must be at least 1");
+        }
+        s.steps = l;
+    }
+    if let Some(p) = args.pyramid {
+        if !(p > 0.0 && p < 1.0) {
+            bail!("--pyramid must be within (0, 1), found {p}");
+        }
+        s.pyramid = p;
+    }
+    if let Some(r) = args.repr {
+        s.repr = match r {
+            ReprArg::Rotation => Repr::Rotation,
+            ReprArg::Velocity => Repr::Velocity,
+            ReprArg::Position => Repr::Position,
+        };
+    }
+    if let Some(b) = args.bound_rotation {
+        s.bound_rotation = match b {
+            BoundArg::Local => BoundRotation::Local,
+            BoundArg::Aligned => BoundRotation::Aligned,
+            BoundArg::World => BoundRotation::World,
+        };
+    }
+    if let Some(r) = args.root_motion {
+        s.root_motion = match r {
+            RootArg::Examples => RootMotion::Examples,
+            RootArg::Source => RootMotion::Source,
+        };
+    }
+    s.frames = match (args.frames, args.seconds) {
+        (Some(0), _) => bail!("--frames must be at least 1"),
+        (Some(n), _) => Some(n),
+        (None, Some(sec)) if sec.is_finite() && sec > 0.0 => Some(((sec * fps).round() as usize).max(1)),
+        (None, Some(sec)) => bail!("--seconds must be a positive number, found {sec}"),
+        (None, None) => None,
+    };
+    if let Some(keys) = &args.key_frames {
+        if keys.is_empty() {
+            bail!("--key-frames needs at least one frame");
+        }
+        if let Some(&k) = keys.iter().find(|&&k| k >= source_frames) {
+            bail!("--key-frames: frame {k} is past the source's last frame {}", source_frames.saturating_sub(1));
+        }
+        s.key_frames = Some(keys.clone());
+    }
+    Ok(s)
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    args.common.init_threads();
+    let started = Instant::now();
+    let count = args.samples as usize;
+    let outputs: Vec<Option<PathBuf>> = match args.common.output.as_deref() {
+        Some(p) if !is_dash(p) && !args.emit_binding && !(args.format == OutFormat::Npy) => {
+            (0..count).map(|i| io::numbered_output(p, i, count).map(Some).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?
+        }
+        Some(p) if !is_dash(p) => vec![Some(p.to_path_buf())],
+        _ if count > 1 && args.format == OutFormat::Bvh && !args.emit_binding => {
+            bail!("{count} samples need a numbered output path such as -o 'out_{{i}}.bvh' (or --format npy for one batch)")
+        }
+        _ => vec![None],
+    };
+
+    let source = read_clip(&args.source)?;
+    if source.motion.frames < 2 {
+        bail!("{}: {} frame(s): a source motion needs at least two frames", source.name, source.motion.frames);
+    }
+    let target_files = expand_inputs(&args.targets)?;
+    if target_files.iter().any(|p| is_dash(p)) && is_dash(&args.source) {
+        bail!("stdin ('-') can be read only once");
+    }
+    let examples = {
+        use rayon::prelude::*;
+        target_files.par_iter().map(|p| read_clip(p)).collect::<anyhow::Result<Vec<Clip>>>()?
+    };
+    let first = &examples[0];
+    for e in &examples[1..] {
+        same_skeleton(first, e)?;
+    }
+    for e in &examples {
+        if e.motion.frames < 2 {
+            bail!("{}: {} frame(s): example clips need at least two frames", e.name, e.motion.frames);
+        }
+    }
+    let target_fps = 1.0 / first.motion.frame_time;
+    if let Some(e) = examples.iter().find(|e| (e.motion.frame_time - first.motion.frame_time).abs() > 1e-6 * first.motion.frame_time) {
+        bail!(
+            "{} runs at {:.3} fps but {} at {:.3} fps: give example clips of one frame rate",
+            e.name,
+            1.0 / e.motion.frame_time,
+            first.name,
+            target_fps
+        );
+    }
+
+    // The binding.
+    let (map, binding): (JointMap, Binding) = if args.bind == "auto" {
+        let (ra, rb) = (canonical_rest(&source)?, canonical_rest(first)?);
+        let opts = AutoOptions { rate: args.bind_rate, ..AutoOptions::default() };
+        let choices = auto::auto_bind(&Body { skeleton: &source.skeleton, rest: &ra }, &Body { skeleton: &first.skeleton, rest: &rb }, &opts)?;
+        let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
+        (choices.iter().map(|c| (c.source, c.target)).collect(), binding)
+    } else {
+        let path = Path::new(&args.bind);
+        let name = io::display_name(path);
+        let text = String::from_utf8(io::read_input(path).with_context(|| format!("cannot read binding {name}"))?)
+            .map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))?;
+        let binding = Binding::from_json(&text, &name)?;
+        (binding.resolve(&name, &source.skeleton, &source.name, &first.skeleton, &first.name)?, binding)
+    };
+    if args.emit_binding {
+        return io::write_output(outputs[0].as_deref(), binding.to_json().as_bytes()).context("cannot write the binding");
+    }
+
+    // Frame rates.
+    let source_fps = 1.0 / source.motion.frame_time;
+    let source_motion = if (source_fps - target_fps).abs() > 1e-6 * target_fps {
+        if !args.common.quiet {
+            eprintln!("mo-retarget: {}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps", source.name);
+        }
+        retarget::resample(&source.motion, target_fps)
+    } else {
+        source.motion.clone()
+    };
+
+    let settings = settings(args, target_fps, source_motion.frames)?;
+    let example_motions: Vec<Motion> = examples.iter().map(|e| e.motion.clone()).collect();
+    let seeds: Vec<u64> = (0..count as u64).map(|i| args.common.seed.wrapping_add(i)).collect();
+    let loaded = started.elapsed();
+    let t0 = Instant::now();
+    let results = retarget::retarget_samples(&source_motion, &source.skeleton, &example_motions, &first.skeleton, &map, &settings, &seeds)
+        .with_context(|| format!("{} -> {}", source.name, first.name))?;
+    let retargeted = t0.elapsed();
+
+    // Everything to bytes first, then write.
+    let t1 = Instant::now();
+    let mut files: Vec<(Option<PathBuf>, Vec<u8>)> = Vec::new();
+    match args.format {
+        OutFormat::Bvh => {
+            for (r, out) in results.iter().zip(&outputs) {
+                files.push((out.clone(), bvh::write_string(&r.motion.to_bvh(&first.skeleton)).into_bytes()));
+            }
+        }
+        OutFormat::Npy => {
+            let features: Vec<_> = results.iter().map(|r| m2m::encode(&r.motion)).collect();
+            let f0 = &features[0];
+            let mut shape = vec![f0.frames, f0.joints, f0.dims];
+            if features.len() > 1 {
+                shape.insert(0, features.len());
+            }
+            let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
+            let mut bytes = Vec::new();
+            npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
+            files.push((outputs[0].clone(), bytes));
+        }
+    }
+    if std::io::IsTerminal::is_terminal(&std::io::stdout()) && args.format == OutFormat::Npy && files.iter().any(|(p, _)| p.is_none()) {
+        bail!("refusing to write NPY to a terminal: give -o FILE or redirect stdout");
+    }
+    for (path, bytes) in &files {
+        let target = path.as_ref().map_or("stdout".to_string(), |p| p.display().to_string());
+        io::write_output(path.as_deref(), bytes).with_context(|| format!("cannot write {target}"))?;
+    }
+    let written = t1.elapsed();
+
+    if args.report && !args.common.quiet {
+        eprintln!(
+            "mo-retarget: {} ({} frames, {} joints) -> {} ({} example clip(s), {} frames, {} joints)",
+            source.name,
+            source_motion.frames,
+            source.skeleton.len(),
+            first.name,
+            examples.len(),
+            examples.iter().map(|e| e.motion.frames).sum::<usize>(),
+            first.skeleton.len()
+        );
+        eprintln!(
+            "mo-retarget: binding: {} pairs, rate {:.1}%",
+            map.len(),
+            100.0 * Binding::rate(map.len(), source.skeleton.len(), first.skeleton.len())
+        );
+        for (p, &(s, t)) in binding.mapping.iter().zip(&map) {
+            let score = p.score.map(|x| format!(" (score {x:.3})")).unwrap_or_default();
+            eprintln!("mo-retarget:   {} -> {}{score}", source.skeleton.joints[s].name, first.skeleton.joints[t].name);
+        }
+        for (i, r) in results.iter().enumerate() {
+            let rep = &r.report;
+            eprintln!(
+                "mo-retarget: sample {i} (seed {}): {} frames ({} constrained by the source), patch {}, {} of {} channels bound, synthesis {:.1} ms",
+                seeds[i],
+                rep.frames,
+                rep.known_frames,
+                rep.patch,
+                rep.bound_channels,
+                rep.channels,
+                rep.timings.synthesis.as_secs_f64() * 1e3
+            );
+            for (l, level) in rep.levels.iter().enumerate() {
+                let costs: Vec<String> = level.step_costs.iter().map(|c| format!("{c:.4}")).collect();
+                eprintln!(
+                    "mo-retarget:   level {l}: {} frames, {} example patches, {} steps, match cost per step [{}]",
+                    level.frames,
+                    level.example_patches,
+                    level.steps,
+                    costs.join(", ")
+                );
+            }
+            for note in &rep.notes {
+                eprintln!("mo-retarget:   note: {note}");
+            }
+        }
+        eprintln!(
+            "mo-retarget: time: load {:.1} ms, retarget {:.1} ms, write {:.1} ms, total {:.1} ms",
+            loaded.as_secs_f64() * 1e3,
+            retargeted.as_secs_f64() * 1e3,
+            written.as_secs_f64() * 1e3,
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    Ok(())
+}
