@@ -139,8 +139,8 @@ pub struct PhysicsReport {
     pub floating: Maybe<Measure>,
     /// Frames with no foot within the contact band.
     pub floating_fraction: Maybe<f64>,
-    /// Mean jerk magnitude (third difference x fps³) over joints and frames.
-    pub jitter: Measure,
+    /// Mean jerk magnitude (third difference x fps³) over joints and frames; needs 4 frames.
+    pub jitter: Maybe<Measure>,
     pub units: PhysicsUnits,
 }
 
@@ -258,9 +258,11 @@ fn horizontal(v: DVec3) -> f64 {
     (v.x * v.x + v.z * v.z).sqrt()
 }
 
-/// Score one motion. Needs 4 frames (jerk is a third difference); errors on non-finite input.
+/// Score one motion; errors on non-finite input. A single frame (a rest pose) still has
+/// penetration and floating; contacts and skating need 2 frames and jitter 4, and are
+/// `NotApplicable` (with the reason) below that.
 pub fn physics(clip: &Clip, opts: &PhysicsOptions) -> Result<PhysicsReport, MetricError> {
-    check_clip(clip, 4, "physics")?;
+    check_clip(clip, 1, "physics")?;
     check_options(opts)?;
     let (frames, fps, scale) = (clip.frames, clip.fps, clip.scale);
     let ground = ground_height(clip, opts.ground);
@@ -280,16 +282,21 @@ pub fn physics(clip: &Clip, opts: &PhysicsOptions) -> Result<PhysicsReport, Metr
     let ground_penetration = Measure::of(depth_sum / frames as f64, scale);
     let penetration_fraction = below as f64 / frames as f64;
 
-    // Jerk: third finite difference of every joint; a constant pose and a constant velocity
-    // (or acceleration) both give exactly zero.
-    let mut jerk_sum = 0.0;
-    for f in 0..frames - 3 {
-        for j in 0..clip.joints {
-            let d3 = clip.at(f + 3, j) - 3.0 * clip.at(f + 2, j) + 3.0 * clip.at(f + 1, j) - clip.at(f, j);
-            jerk_sum += d3.length();
+    // Jerk: third finite difference of every joint, built from one-frame steps so that a
+    // constant pose gives exactly zero (constant velocity or acceleration: zero up to rounding).
+    let jitter = if frames < 4 {
+        Maybe::NotApplicable(format!("jerk needs 4 frames (a third difference), the clip has {frames}"))
+    } else {
+        let mut jerk_sum = 0.0;
+        for f in 0..frames - 3 {
+            for j in 0..clip.joints {
+                let step = |k: usize| clip.at(f + k + 1, j) - clip.at(f + k, j);
+                let (a, b, c) = (step(0), step(1), step(2));
+                jerk_sum += ((c - b) - (b - a)).length();
+            }
         }
-    }
-    let jitter = Measure::of(jerk_sum / ((frames - 3) * clip.joints) as f64 * fps * fps * fps, scale);
+        Maybe::Value(Measure::of(jerk_sum / ((frames - 3) * clip.joints) as f64 * fps * fps * fps, scale))
+    };
 
     let (contact_fraction, foot_skating, skating_fraction, floating, floating_fraction) = if clip.feet.is_empty() {
         let why = "the skeleton has no feet (skeleton::roles::feet found none)".to_string();
@@ -328,10 +335,17 @@ pub fn physics(clip: &Clip, opts: &PhysicsOptions) -> Result<PhysicsReport, Metr
             float_sum += gap;
             airborne += usize::from(gap > 0.0);
         }
+        let moving = |v: Maybe<f64>| {
+            if frames < 2 {
+                Maybe::NotApplicable("contacts and skating need 2 frames (a speed), the clip has 1".to_string())
+            } else {
+                v
+            }
+        };
         (
-            Maybe::Value(contact_fraction),
-            Maybe::Value(Measure::of(skating, scale)),
-            Maybe::Value(skating_fraction),
+            moving(Maybe::Value(contact_fraction)),
+            moving(Maybe::Value(skating)).map(|v| Measure::of(v, scale)),
+            moving(Maybe::Value(skating_fraction)),
             Maybe::Value(Measure::of(float_sum / frames as f64, scale)),
             Maybe::Value(airborne as f64 / frames as f64),
         )
@@ -382,7 +396,7 @@ pub(crate) mod tests {
         let clip = biped(10, 30.0, |_| DVec3::ZERO);
         let r = physics(&clip, &PhysicsOptions::default()).unwrap();
         assert_eq!(r.ground_penetration.value, 0.0);
-        assert_eq!(r.jitter.value, 0.0);
+        assert_eq!(r.jitter.value().unwrap().value, 0.0);
         assert_eq!(r.foot_skating, Maybe::Value(Measure { value: 0.0, normalised: 0.0 }));
         assert_eq!(r.floating, Maybe::Value(Measure { value: 0.0, normalised: 0.0 }));
         assert_eq!(r.contact_fraction, Maybe::Value(1.0));
@@ -400,7 +414,7 @@ pub(crate) mod tests {
         assert_eq!(r.skating_fraction, Maybe::Value(1.0));
         assert_eq!(r.contact_fraction, Maybe::Value(0.0));
         // Constant velocity has no jerk.
-        assert!(r.jitter.value.abs() < 1e-9);
+        assert!(r.jitter.value().unwrap().value.abs() < 1e-9);
     }
 
     #[test]
@@ -427,7 +441,9 @@ pub(crate) mod tests {
         // Foot and hip follow x = f³ / 6 at 10 fps: third difference 1 per frame³ -> 1000/s³.
         let clip = biped(6, 10.0, |f| DVec3::new((f * f * f) as f64 / 6.0, 0.0, 0.0));
         let r = physics(&clip, &PhysicsOptions::default()).unwrap();
-        assert!((r.jitter.value - 1000.0).abs() < 1e-9, "{}", r.jitter.value);
+        assert!((r.jitter.value().unwrap().value - 1000.0).abs() < 1e-9, "{:?}", r.jitter);
+        let short = physics(&biped(3, 10.0, |_| DVec3::ZERO), &PhysicsOptions::default()).unwrap();
+        assert!(matches!(short.jitter, Maybe::NotApplicable(_)));
     }
 
     #[test]
@@ -443,7 +459,12 @@ pub(crate) mod tests {
     #[test]
     fn bad_input_is_an_error_not_a_panic() {
         let opts = PhysicsOptions::default();
-        assert!(matches!(physics(&biped(1, 30.0, |_| DVec3::ZERO), &opts), Err(MetricError::TooLittle(_))));
+        assert!(matches!(physics(&biped(0, 30.0, |_| DVec3::ZERO), &opts), Err(MetricError::TooLittle(_))));
+        // One frame: a pose can penetrate or float, but not skate or jitter.
+        let one = physics(&biped(1, 30.0, |_| DVec3::new(0.0, -0.2, 0.0)), &opts).unwrap();
+        assert!((one.ground_penetration.value - 0.2).abs() < 1e-12);
+        assert!(matches!(one.foot_skating, Maybe::NotApplicable(_)) && matches!(one.jitter, Maybe::NotApplicable(_)));
+        assert!(matches!(one.contact_fraction, Maybe::NotApplicable(_)));
         let mut nan = biped(6, 30.0, |_| DVec3::ZERO);
         nan.positions[5].y = f64::NAN;
         let e = physics(&nan, &opts).unwrap_err();
