@@ -215,6 +215,9 @@ fn one_frame_and_nan_inputs_are_errors_everywhere() {
     assert!(matches!(reconstruction::reconstruction(&clip, &clip, Some(&rot), 1.0, &opts), Err(MetricError::NonFinite(_))));
 }
 
+/// Frames of each corpus file the kinetic and geometric features look at.
+const FEATURE_FRAMES: usize = 300;
+
 /// Physics (and the features) on every corpus file: no error, nothing non-finite. Prints the
 /// wall time of the physics pass (loading excluded) and which files have human roles.
 #[test]
@@ -247,9 +250,18 @@ fn physics_on_every_corpus_file() {
                 assert!(matches!(kinetic::kinetic_features(c), Err(MetricError::TooLittle(_))), "{name}");
                 return None;
             }
-            let k = kinetic::kinetic_features(c).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let k = kinetic::kinetic_features(&window(c, 0, c.frames.min(FEATURE_FRAMES))).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(k.iter().all(|x| x.is_finite()), "{name}");
-            let roles = geometric::human_roles(c).ok()?;
+            let roles = match geometric::human_roles(c) {
+                Ok(r) => r,
+                Err(why) => {
+                    eprintln!("no human roles in {name}: {why}");
+                    return None;
+                }
+            };
+            // The features on a prefix: they are per-frame averages, and the full corpus in an
+            // unoptimised test build would take seconds.
+            let c = &window(c, 0, c.frames.min(FEATURE_FRAMES));
             let g = geometric::geometric_features(c, &roles, &GeometricOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(g.iter().all(|x| (0.0..=1.0).contains(x)), "{name}");
             Some(name.clone())
@@ -258,7 +270,7 @@ fn physics_on_every_corpus_file() {
     let features_time = t2.elapsed();
     let with_roles = human.iter().flatten().count();
     eprintln!(
-        "{} files, {frames} frames: loading+FK {:.2} s, physics {:.3} s, kinetic+geometric {:.2} s ({} threads); human roles in {with_roles} files",
+        "{} files, {frames} frames: loading+FK {:.2} s, physics {:.3} s, kinetic+geometric on {FEATURE_FRAMES}-frame prefixes {:.2} s ({} threads); human roles in {with_roles} files",
         files.len(),
         loading.as_secs_f64(),
         physics_time.as_secs_f64(),
