@@ -74,7 +74,7 @@ fn a_motion_against_itself_identical_shifted_mirrored_scaled() {
     // Mirroring keeps the physics of a y-up motion: same skating, penetration, jitter.
     let (p0, p1) = (physics::physics(&clip, &opts).unwrap(), physics::physics(&mirrored, &opts).unwrap());
     assert_eq!(p0.ground_penetration, p1.ground_penetration);
-    let jitter = |p: &physics::PhysicsReport| p.jitter.value().unwrap().clone();
+    let jitter = |p: &physics::PhysicsReport| *p.jitter.value().unwrap();
     assert!((jitter(&p0).value - jitter(&p1).value).abs() < 1e-9 * jitter(&p0).value.max(1.0));
 
     // Scaled by s about the origin: joints move (s - 1)|p|; kinetic energies scale by s²,

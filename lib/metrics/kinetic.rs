@@ -38,11 +38,11 @@ pub fn kinetic_features(clip: &Clip) -> Result<Vec<f64>, MetricError> {
             let mut m = 0usize;
             for o in -WINDOW..=WINDOW {
                 let k = i + o;
-                if k - 1 >= 0 && k < t {
+                if k >= 1 && k < t {
                     displacement += p(k) - p(k - 1);
                     n += 1;
                 }
-                if k - 1 >= 0 && k + 1 < t {
+                if k >= 1 && k + 1 < t {
                     acceleration += ((p(k + 1) - p(k)) - (p(k) - p(k - 1))) / (dt * dt);
                     m += 1;
                 }

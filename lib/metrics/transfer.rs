@@ -165,9 +165,7 @@ pub fn contact_consistency(
     let (src_contacts, res_contacts) = (physics::contacts(source, opts), physics::contacts(result, opts));
     // Per frame: is some foot of the subtree of j in contact? `None` when the subtree has none.
     let signal = |clip: &Clip, rows: &[Vec<bool>], j: usize| -> Option<Vec<bool>> {
-        if clip.parents[j].is_none() {
-            return None;
-        }
+        clip.parents[j]?;
         let inside = subtree(clip, j);
         let feet: Vec<usize> = clip.feet.iter().enumerate().filter(|(_, &f)| inside[f]).map(|(i, _)| i).collect();
         (!feet.is_empty()).then(|| (0..clip.frames).map(|f| feet.iter().any(|&i| rows[i][f])).collect())
@@ -335,7 +333,7 @@ mod tests {
         // Pairs: a-b 0.3, a-c 0.3, b-c 0.6 -> mean 0.4.
         let d = diversity(&[a.clone(), b, c]).unwrap();
         assert!((d.value - 0.4).abs() < 1e-12);
-        assert!(matches!(diversity(&[a.clone()]), Err(MetricError::TooLittle(_))));
+        assert!(matches!(diversity(std::slice::from_ref(&a)), Err(MetricError::TooLittle(_))));
         assert!(matches!(diversity(&[a.clone(), sway(11, 30.0, 1.0, 0.0)]), Err(MetricError::Mismatch(_))));
         assert_eq!(throughput(300, 1.5).unwrap(), 200.0);
         assert!(throughput(300, 0.0).is_err() && throughput(300, f64::NAN).is_err() && throughput(0, 1.0).is_err());
