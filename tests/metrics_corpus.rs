@@ -280,3 +280,35 @@ fn physics_on_every_corpus_file() {
     // The corpus has human mocap (lafan1, cmu, xia ...): roles must be found in those.
     assert!(with_roles * 3 >= files.len(), "human roles found in only {with_roles} of {} files", files.len());
 }
+
+/// Frequency alignment and contact consistency of a long corpus clip against itself shifted
+/// by half a second: timing printed, values in range.
+#[test]
+fn transfer_metrics_on_a_long_corpus_clip() {
+    let Some(data) = common::shared_data("transfer_metrics_on_a_long_corpus_clip") else { return };
+    let files = common::corpus_bvh_files(&data);
+    let Some(path) = files.iter().find(|p| p.to_string_lossy().contains("lafan1/walk")) else { return };
+    let (_, _, clip) = load(path);
+    let n = clip.frames.min(1000);
+    let k = (clip.fps * 0.5).round() as usize;
+    if clip.frames < n + k {
+        return;
+    }
+    let (a, b) = (window(&clip, 0, n), window(&clip, k, n));
+    let pairs: Vec<(usize, usize)> = clip.feet.iter().map(|&f| (f, f)).collect();
+    let t = Instant::now();
+    let fa = transfer::frequency_alignment(&a, &b, &pairs).unwrap();
+    let fa_time = t.elapsed();
+    let cc = transfer::contact_consistency(&a, &b, &pairs, &PhysicsOptions::default()).unwrap();
+    eprintln!(
+        "{n} frames, {} foot pairs: frequency alignment {:.3} in {:.3} s ({} bins); contact consistency {:.3}",
+        pairs.len(),
+        fa.value,
+        fa_time.as_secs_f64(),
+        fa.bins,
+        cc.value().map_or(f64::NAN, |c| c.value)
+    );
+    // The same walk half a second later has the same rhythm; its contacts are out of phase.
+    assert!(fa.value > 0.8 && fa.value <= 1.0, "{fa:?}");
+    assert!(cc.value().is_some_and(|c| (0.0..=1.0).contains(&c.value)));
+}
