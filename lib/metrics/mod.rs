@@ -49,6 +49,24 @@ impl Clip {
         self.positions[f * self.joints + j]
     }
 
+    /// A motion on its skeleton as a clip: our forward kinematics, feet by
+    /// `skeleton::roles::feet`, scale `Skeleton::rest_extent`, fps `1 / frame_time` (a zero or
+    /// negative frame time gives a non-finite or negative fps, which every metric refuses).
+    /// `motion` must be on `skeleton` (as every loader in `cli::load` returns them).
+    pub fn from_motion(skeleton: &crate::skeleton::Skeleton, motion: &crate::motion::Motion) -> Clip {
+        let pose = motion.forward_kinematics(skeleton);
+        Clip {
+            frames: pose.frames,
+            joints: pose.joints,
+            fps: 1.0 / motion.frame_time,
+            positions: pose.positions,
+            parents: skeleton.parents(),
+            names: skeleton.joints.iter().map(|j| j.name.clone()).collect(),
+            feet: crate::skeleton::roles::feet(skeleton).0,
+            scale: skeleton.rest_extent(),
+        }
+    }
+
     /// The first non-finite coordinate, as (frame, joint).
     pub fn first_non_finite(&self) -> Option<(usize, usize)> {
         self.positions.iter().position(|p| !p.is_finite()).map(|i| (i / self.joints.max(1), i % self.joints.max(1)))
