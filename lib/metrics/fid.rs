@@ -12,7 +12,7 @@
 //! by the **real** set's per-dimension mean and population std. [`FidOptions::normalise`]
 //! does that (default on). Definitions and deviations: `docs/metrics-generation.md`.
 
-use super::linalg::{covariance, eigen_tolerance, matmul, sqrtm_psd, symmetric_eigen, trace};
+use super::linalg::{covariance, eigen_tolerance, matmul, sqrtm_psd, symmetric_eigenvalues, trace};
 use super::MetricError;
 
 /// A real-set dimension whose std is at most this fraction of max(1, |mean|) is constant:
@@ -93,7 +93,7 @@ pub fn frechet_distance(mu1: &[f64], s1: &[f64], mu2: &[f64], s2: &[f64], dims: 
             m[j * dims + i] = v;
         }
     }
-    let (values, _) = symmetric_eigen(&m, dims);
+    let values = symmetric_eigenvalues(&m, dims);
     let tol = eigen_tolerance(&values);
     let cross: f64 = values.iter().map(|&v| if v > tol { v.sqrt() } else { 0.0 }).sum();
     let value = mean_term + trace(s1, dims) + trace(s2, dims) - 2.0 * cross;

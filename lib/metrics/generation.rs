@@ -194,6 +194,44 @@ fn frame_distance(a: &[f64], b: &[f64]) -> f64 {
     sum / points.max(1) as f64
 }
 
+/// A clip's frames in planar layout: per frame all x, then all y, then all z, so that
+/// [`planar_distance`] runs over contiguous lanes.
+fn planar(c: &PointClip) -> Vec<f64> {
+    let points = c.points();
+    let mut out = vec![0.0; c.values.len()];
+    for (src, dst) in c.values.chunks_exact(c.dims).zip(out.chunks_exact_mut(c.dims)) {
+        for (p, xyz) in src.chunks_exact(3).enumerate() {
+            dst[p] = xyz[0];
+            dst[points + p] = xyz[1];
+            dst[2 * points + p] = xyz[2];
+        }
+    }
+    out
+}
+
+/// [`frame_distance`] of two planar frames, summed in four interleaved lanes (a fixed order,
+/// so results do not depend on the machine, and one the compiler can vectorise).
+fn planar_distance(a: &[f64], b: &[f64], points: usize) -> f64 {
+    let (ax, ayz) = a.split_at(points);
+    let (ay, az) = ayz.split_at(points);
+    let (bx, byz) = b.split_at(points);
+    let (by, bz) = byz.split_at(points);
+    let mut lanes = [0.0f64; 4];
+    let whole = points / 4 * 4;
+    for base in (0..whole).step_by(4) {
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            let i = base + l;
+            let (dx, dy, dz) = (ax[i] - bx[i], ay[i] - by[i], az[i] - bz[i]);
+            *lane += (dx * dx + dy * dy + dz * dz).sqrt();
+        }
+    }
+    for i in whole..points {
+        let (dx, dy, dz) = (ax[i] - bx[i], ay[i] - by[i], az[i] - bz[i]);
+        lanes[i - whole] += (dx * dx + dy * dy + dz * dz).sqrt();
+    }
+    ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) / points.max(1) as f64
+}
+
 /// Mean frame distance over the first `min(len)` frames (`avg_per_frame_dist`, loc norm).
 fn average_frame_distance(a: &PointClip, a0: usize, b: &PointClip, b0: usize, len: usize) -> f64 {
     let total: f64 = (0..len).map(|t| frame_distance(a.frame(a0 + t), b.frame(b0 + t))).sum();
@@ -413,25 +451,26 @@ pub fn generation_metrics(
         })
         .collect();
 
-    // GT frames, concatenated, and where each kept clip starts.
+    // GT frames, concatenated (in the planar layout of `planar`), and where each clip starts.
+    let points = dims / 3;
     let mut gt_starts = Vec::with_capacity(kept.len());
     let mut gt_all = Vec::with_capacity(gt_frames * dims);
     for c in &kept {
         gt_starts.push(gt_all.len() / dims);
-        gt_all.extend_from_slice(&c.values);
+        gt_all.extend(planar(c));
     }
-    let gt_frame = |f: usize| &gt_all[f * dims..(f + 1) * dims];
 
     // cost[i][a * gt_frames + b]: distance of sample i's frame a to GT frame b. Shared by
-    // local and global diversity and (transposed) coverage.
+    // local and global diversity and coverage.
     let cost: Vec<Vec<f64>> = generated
         .par_iter()
         .map(|c| {
+            let frames = planar(c);
             let mut m = vec![0.0; c.frames * gt_frames];
             m.par_chunks_mut(gt_frames).enumerate().for_each(|(a, row)| {
-                let fa = c.frame(a);
-                for (b, out) in row.iter_mut().enumerate() {
-                    *out = frame_distance(fa, gt_frame(b));
+                let fa = &frames[a * dims..(a + 1) * dims];
+                for (out, fb) in row.iter_mut().zip(gt_all.chunks_exact(dims)) {
+                    *out = planar_distance(fa, fb, points);
                 }
             });
             m
@@ -484,26 +523,52 @@ pub fn generation_metrics(
     let gt_intra_stats = MeanStd::of(&gt_intra);
     let diff: Vec<f64> = intra.iter().map(|v| (v - gt_intra_stats.mean).abs()).collect();
 
-    // Coverage: GT windows against the concatenated subset, per repetition.
+    // Coverage: GT windows against the concatenated subset, per repetition. The nearest
+    // window of every GT start g is found by running over target starts k and, for each,
+    // summing rows k..k+w of the cost (contiguous in g); a minimum does not depend on the
+    // order it is taken in, so chunks of k can run in parallel.
+    let gt_starts_all = gt_frames - w + 1;
     let coverages: Vec<f64> = subsets
         .iter()
         .map(|subset| {
-            let target: Vec<(usize, usize)> =
-                subset.iter().flat_map(|&s| (0..generated[s].frames).map(move |f| (s, f))).collect();
-            let nt = target.len();
-            let mut m = vec![0.0; gt_frames * nt];
-            m.par_chunks_mut(nt).enumerate().for_each(|(b, row)| {
-                for (c, &(s, f)) in row.iter_mut().zip(&target) {
-                    *c = cost[s][f * gt_frames + b];
-                }
-            });
+            let rows: Vec<&[f64]> = subset
+                .iter()
+                .flat_map(|&s| cost[s].chunks_exact(gt_frames))
+                .collect();
+            let target_starts = rows.len() - w + 1;
+            let best = (0..target_starts)
+                .into_par_iter()
+                .fold(
+                    || vec![f64::INFINITY; gt_starts_all],
+                    |mut best, k| {
+                        let mut acc = vec![0.0; gt_starts_all];
+                        for t in 0..w {
+                            for (a, v) in acc.iter_mut().zip(&rows[k + t][t..t + gt_starts_all]) {
+                                *a += v;
+                            }
+                        }
+                        for (b, a) in best.iter_mut().zip(&acc) {
+                            *b = b.min(*a);
+                        }
+                        best
+                    },
+                )
+                .reduce(
+                    || vec![f64::INFINITY; gt_starts_all],
+                    |mut x, y| {
+                        for (a, b) in x.iter_mut().zip(&y) {
+                            *a = a.min(*b);
+                        }
+                        x
+                    },
+                );
             let mut covered = 0usize;
             let mut total = 0usize;
             for (k, g) in kept.iter().enumerate() {
-                let rows = &m[gt_starts[k] * nt..(gt_starts[k] + g.frames) * nt];
-                let minima = window_minima(rows, nt, 0, nt, g.frames - w, w);
-                covered += minima.iter().filter(|&&v| v / (w as f64) < opts.threshold).count();
-                total += minima.len();
+                // Starts 0..L − w, as the reference counts them (its last start is left out).
+                let starts = &best[gt_starts[k]..gt_starts[k] + g.frames - w];
+                covered += starts.iter().filter(|&&v| v / (w as f64) < opts.threshold).count();
+                total += starts.len();
             }
             covered as f64 / total as f64 * 100.0
         })

@@ -24,6 +24,17 @@ const MAX_QL_ITERATIONS: usize = 64;
 /// `k`) is the contiguous slice `vectors[k * n..(k + 1) * n]`. Only the symmetric part
 /// `(a + aᵀ) / 2` is used, so rounding asymmetry in the input does no harm.
 pub fn symmetric_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
+    let (values, vectors) = decompose(a, n, true);
+    (values, vectors)
+}
+
+/// Eigenvalues (ascending) of the symmetric `n × n` matrix `a`, without the eigenvectors
+/// (about half the work of [`symmetric_eigen`]).
+pub fn symmetric_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
+    decompose(a, n, false).0
+}
+
+fn decompose(a: &[f64], n: usize, want_vectors: bool) -> (Vec<f64>, Vec<f64>) {
     if n == 0 {
         return (Vec::new(), Vec::new());
     }
@@ -34,31 +45,38 @@ pub fn symmetric_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
             m[i * n + j] = 0.5 * (at(i, j) + at(j, i));
         }
     }
-    let (mut d, mut e, mut z) = tridiagonalise(m, n);
-    implicit_ql(&mut d, &mut e, &mut z, n);
+    let (mut d, mut e, mut zt) = tridiagonalise(m, n, want_vectors);
+    implicit_ql(&mut d, &mut e, &mut zt, n);
 
-    // Sort ascending (stable on ties, so output is deterministic) and lay vectors out by column.
+    // Sort ascending (stable on ties, so output is deterministic); `zt` already holds one
+    // eigenvector per row.
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&x, &y| d[x].total_cmp(&d[y]));
     let values = order.iter().map(|&k| d[k]).collect();
-    let mut vectors = vec![0.0; n * n];
-    for (col, &k) in order.iter().enumerate() {
-        for row in 0..n {
-            vectors[col * n + row] = z[row * n + k];
+    let mut vectors = Vec::new();
+    if want_vectors {
+        vectors.reserve(n * n);
+        for &k in &order {
+            vectors.extend_from_slice(&zt[k * n..(k + 1) * n]);
         }
     }
     (values, vectors)
 }
 
 /// Householder reduction: returns the diagonal `d`, the off-diagonal `e` (`e[i]` couples `i`
-/// and `i + 1`, `e[n - 1] = 0`) and the orthogonal `Q` (row-major) with `A = Q T Qᵀ`.
-fn tridiagonalise(mut a: Vec<f64>, n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let mut q = vec![0.0; n * n];
-    for i in 0..n {
-        q[i * n + i] = 1.0;
+/// and `i + 1`, `e[n - 1] = 0`) and, when asked, Qᵀ (row-major; empty otherwise) with
+/// `A = Q T Qᵀ`. Qᵀ rather than Q so that the QL rotations, which mix two columns of Q, touch
+/// two contiguous rows.
+fn tridiagonalise(mut a: Vec<f64>, n: usize, want_q: bool) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut q = vec![0.0; if want_q { n * n } else { 0 }];
+    if want_q {
+        for i in 0..n {
+            q[i * n + i] = 1.0;
+        }
     }
     let mut v = vec![0.0; n];
     let mut p = vec![0.0; n];
+    let mut vq = vec![0.0; n];
     for k in 0..n.saturating_sub(2) {
         // Reflect x = a[k+1.., k] onto a multiple of the first unit vector.
         let lo = k + 1;
@@ -97,12 +115,18 @@ fn tridiagonalise(mut a: Vec<f64>, n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
             a[i * n + k] = 0.0;
             a[k * n + i] = 0.0;
         }
-        // Q ← Q H (H acts on indices lo..n).
-        for r in 0..n {
-            let qv = beta * (lo..n).map(|j| q[r * n + j] * v[j]).sum::<f64>();
-            if qv != 0.0 {
-                for j in lo..n {
-                    q[r * n + j] -= qv * v[j];
+        // Q ← Q H (H acts on indices lo..n), i.e. rows lo..n of Qᵀ: Qᵀ ← Qᵀ − β v (vᵀ Qᵀ).
+        if want_q {
+            vq.iter_mut().for_each(|x| *x = 0.0);
+            for j in lo..n {
+                for (x, qc) in vq.iter_mut().zip(&q[j * n..(j + 1) * n]) {
+                    *x += v[j] * qc;
+                }
+            }
+            for j in lo..n {
+                let bv = beta * v[j];
+                for (qc, x) in q[j * n..(j + 1) * n].iter_mut().zip(&vq) {
+                    *qc -= bv * x;
                 }
             }
         }
@@ -112,8 +136,9 @@ fn tridiagonalise(mut a: Vec<f64>, n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     (d, e, q)
 }
 
-/// Implicit QL on the tridiagonal (d, e); rotations are accumulated into the columns of `z`.
-fn implicit_ql(d: &mut [f64], e: &mut [f64], z: &mut [f64], n: usize) {
+/// Implicit QL on the tridiagonal (d, e); rotations are accumulated into the rows of `zt`
+/// (eigenvector i ends up in row i), unless it is empty.
+fn implicit_ql(d: &mut [f64], e: &mut [f64], zt: &mut [f64], n: usize) {
     for l in 0..n {
         let mut iterations = 0;
         loop {
@@ -157,11 +182,15 @@ fn implicit_ql(d: &mut [f64], e: &mut [f64], z: &mut [f64], n: usize) {
                 p = s * r;
                 d[i + 1] = g + p;
                 g = c * r - b;
-                for k in 0..n {
-                    let zi1 = z[k * n + i + 1];
-                    let zi = z[k * n + i];
-                    z[k * n + i + 1] = s * zi + c * zi1;
-                    z[k * n + i] = c * zi - s * zi1;
+                if !zt.is_empty() {
+                    let (head, tail) = zt.split_at_mut((i + 1) * n);
+                    let row_i = &mut head[i * n..];
+                    let row_i1 = &mut tail[..n];
+                    for (zi, zi1) in row_i.iter_mut().zip(row_i1.iter_mut()) {
+                        let (a, b) = (*zi, *zi1);
+                        *zi1 = s * a + c * b;
+                        *zi = c * a - s * b;
+                    }
                 }
             }
             if deflated {
@@ -311,6 +340,19 @@ mod tests {
         for (n, seed) in [(1, 1), (2, 2), (3, 3), (7, 4), (40, 5)] {
             check(&random_symmetric(n, seed), n, 1e-10);
         }
+    }
+
+    #[test]
+    fn eigenvalues_alone_match_the_full_decomposition() {
+        let a = random_symmetric(30, 9);
+        let (full, _) = symmetric_eigen(&a, 30);
+        let alone = symmetric_eigenvalues(&a, 30);
+        for (x, y) in full.iter().zip(&alone) {
+            assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+        }
+        // Trace is preserved.
+        let tr: f64 = alone.iter().sum();
+        assert!((tr - trace(&a, 30)).abs() < 1e-10);
     }
 
     #[test]
