@@ -618,13 +618,16 @@ fn window_minima(m: &[f64], cols: usize, c0: usize, width: usize, starts: usize,
 /// into consecutive pieces of at least `min_segment` frames, each matched to an equally long
 /// run of target columns `c0..c0 + width`; infinite when no such tiling exists.
 fn tiling_cost(m: &[f64], cols: usize, len: usize, c0: usize, width: usize, min_segment: usize) -> f64 {
-    // best[l][s]: cheapest match of the piece [l, l + s) (s ≥ min_segment), grown one frame
-    // at a time from the same running sums.
-    let mut best = vec![f64::INFINITY; (len + 1) * (len + 1)];
+    // g[e]: cheapest tiling of frames [0, e). Pieces [l, l + s) only feed g[l + s] with
+    // s ≥ min_segment, so g[l] is final when l is reached and the pieces starting there can be
+    // pushed forward at once: no table of piece costs is kept. Each piece's cost comes from
+    // running sums over its diagonals, grown one frame at a time.
+    let mut g = vec![f64::INFINITY; len + 1];
+    g[0] = 0.0;
     let mut acc = vec![0.0; width];
     for l in 0..len {
         let longest = (len - l).min(width);
-        if longest < min_segment {
+        if longest < min_segment || !g[l].is_finite() {
             continue;
         }
         acc.iter_mut().for_each(|a| *a = 0.0);
@@ -639,17 +642,10 @@ fn tiling_cost(m: &[f64], cols: usize, len: usize, c0: usize, width: usize, min_
                 least = least.min(*a);
             }
             if s >= min_segment {
-                best[l * (len + 1) + s] = least;
-            }
-        }
-    }
-    let mut g = vec![f64::INFINITY; len + 1];
-    g[0] = 0.0;
-    for end in min_segment..=len {
-        for l in 0..=end - min_segment {
-            let v = g[l] + best[l * (len + 1) + end - l];
-            if v < g[end] {
-                g[end] = v;
+                let v = g[l] + least;
+                if v < g[l + s] {
+                    g[l + s] = v;
+                }
             }
         }
     }
@@ -670,6 +666,12 @@ mod tests {
         assert_eq!(tiling_cost(&m, 5, 4, 0, 5, 2), 0.0);
         // Pieces longer than the target cannot exist.
         assert!(tiling_cost(&m, 5, 4, 0, 1, 2).is_infinite());
+        // A 2-frame target forces two pieces of 2: rows 0-1 match it at cost 0 + 0, rows 2-3
+        // at 1 + 1; a 3-frame piece does not fit, a 1-frame piece is too short.
+        let m = [0.0, 5.0, 5.0, 0.0, 1.0, 9.0, 9.0, 1.0];
+        assert_eq!(tiling_cost(&m, 2, 4, 0, 2, 2), 2.0);
+        assert!(tiling_cost(&m, 2, 3, 0, 2, 2).is_infinite());
+        assert_eq!(tiling_cost(&m, 2, 3, 0, 2, 1), 1.0);
     }
 
     /// A clip whose frame t is `f(t)` (a list of points).
