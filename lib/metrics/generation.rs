@@ -1,1 +1,872 @@
-//! (being written)
+//! AnyTop's generation metrics: coverage, local / global / inter / intra diversity and the
+//! intra-diversity difference (paper §5, reference `eval/eval_truebones.py`, reference/anytop.md
+//! §6). They descend from GANimator's and SinMDM's single-motion metrics: windows of a motion
+//! are matched to their nearest windows in another set, and a dynamic programme tiles a
+//! generated motion with pieces of a ground-truth (GT) clip.
+//!
+//! Everything works on [`PointClip`]s: per-frame sets of 3-D points, compared by the mean
+//! Euclidean distance of corresponding points (the reference's `pos_avg_l2`, "loc" mode). The
+//! reference's points are the RIC positions of every non-root joint with the root height
+//! subtracted, in AnyTop's scaled units (mean bone = 0.2092, the mean SMPL bone), so the
+//! distances are comparable across skeletons and with the coverage threshold.
+//!
+//! Determinism: every random draw (window offsets, coverage subsets) comes from one SplitMix64
+//! stream seeded by [`GenerationOptions::seed`], drawn in a fixed order before any parallel
+//! work; parallel loops only fill per-item slots, and every reduction runs in item order. So
+//! the same input and seed give bit-identical reports at any thread count.
+//!
+//! Definitions, units and deviations from the reference: `docs/metrics-generation.md`.
+
+use super::{Clip, MetricError};
+use crate::repr::anytop::{Facing, HUMANML_MEAN_BONE_LENGTH};
+use crate::synth::SplitMix64;
+use glam::{DQuat, DVec3};
+use rayon::prelude::*;
+
+/// A motion as per-frame vectors of 3-D points (`dims = 3 × points`), row-major by frame.
+#[derive(Clone, Debug)]
+pub struct PointClip {
+    frames: usize,
+    dims: usize,
+    values: Vec<f64>,
+}
+
+/// How [`PointClip::from_clip_with`] builds the reference's features from world positions.
+#[derive(Clone, Debug, Default)]
+pub struct PointFeatures {
+    /// Facing rule; every frame is turned (about +y) so that it faces +Z, as AnyTop's RIC
+    /// positions are. `None` keeps world axes: right for clips that do not turn, otherwise
+    /// pass the skeleton's rule (`AnyTopRig::facing`).
+    pub facing: Option<Facing>,
+    /// Multiplier to AnyTop's scaled units (`AnyTopRig::scale_factor`). `None`: 0.2092… / the
+    /// mean bone length (joint to parent) of the clip's frame 0.
+    pub scale: Option<f64>,
+}
+
+impl PointClip {
+    /// `frames × dims` values, row-major; `dims` must be a positive multiple of 3 (points).
+    pub fn new(frames: usize, dims: usize, values: Vec<f64>) -> Result<PointClip, MetricError> {
+        if dims == 0 || dims % 3 != 0 {
+            return Err(MetricError::Mismatch(format!("point clip: {dims} values per frame is not a positive multiple of 3")));
+        }
+        if values.len() != frames * dims {
+            return Err(MetricError::Mismatch(format!(
+                "point clip: {} values for {frames} frames of {dims} (expected {})",
+                values.len(),
+                frames * dims
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(MetricError::NonFinite(format!(
+                "point clip: frame {} value {} is {}",
+                i / dims,
+                i % dims,
+                values[i]
+            )));
+        }
+        Ok(PointClip { frames, dims, values })
+    }
+
+    /// The reference's features from AnyTop's 13-D features `[frames, joints, 13]` (physical,
+    /// denormalised units, as `mo-sample` writes and the reference evaluates): dims 0..3 of
+    /// every non-root joint, with the root's height (root dim 1) subtracted from y.
+    pub fn from_anytop_features(frames: usize, joints: usize, features: &[f32]) -> Result<PointClip, MetricError> {
+        const D: usize = crate::repr::anytop::FEATURE_DIMS;
+        if features.len() != frames * joints * D {
+            return Err(MetricError::Mismatch(format!(
+                "AnyTop features: {} values for {frames} frames × {joints} joints × {D} (expected {})",
+                features.len(),
+                frames * joints * D
+            )));
+        }
+        if joints < 2 {
+            return Err(MetricError::TooLittle(format!("AnyTop features: {joints} joint(s); the metrics use the non-root joints")));
+        }
+        let mut values = Vec::with_capacity(frames * (joints - 1) * 3);
+        for t in 0..frames {
+            let row = &features[t * joints * D..(t + 1) * joints * D];
+            let root_y = row[1] as f64;
+            for j in 1..joints {
+                let f = &row[j * D..j * D + 3];
+                values.extend([f[0] as f64, f[1] as f64 - root_y, f[2] as f64]);
+            }
+        }
+        PointClip::new(frames, (joints - 1) * 3, values)
+    }
+
+    /// The reference's features from world positions, with the default [`PointFeatures`]
+    /// (world axes, scale from the clip's own bones).
+    pub fn from_clip(clip: &Clip) -> Result<PointClip, MetricError> {
+        PointClip::from_clip_with(clip, &PointFeatures::default())
+    }
+
+    /// The reference's features from world positions: for every frame and every joint but
+    /// joint 0 (the root), `s · r_t · (p_j − p_root)`, with r_t the yaw turning frame t to
+    /// face +Z (identity without a facing rule; a degenerate frame keeps the previous yaw)
+    /// and `s` the scale to AnyTop units. This equals the reference's RIC position with the
+    /// root height subtracted.
+    pub fn from_clip_with(clip: &Clip, features: &PointFeatures) -> Result<PointClip, MetricError> {
+        if clip.positions.len() != clip.frames * clip.joints {
+            return Err(MetricError::Mismatch(format!(
+                "clip: {} positions for {} frames × {} joints",
+                clip.positions.len(),
+                clip.frames,
+                clip.joints
+            )));
+        }
+        if let Some((f, j)) = clip.first_non_finite() {
+            return Err(MetricError::NonFinite(format!("clip: frame {f} joint {j} has a non-finite position")));
+        }
+        if clip.joints < 2 {
+            return Err(MetricError::TooLittle(format!("clip: {} joint(s); the metrics use the non-root joints", clip.joints)));
+        }
+        if let Some(facing) = &features.facing {
+            if let Some(&bad) = facing.joints().iter().find(|&&j| j >= clip.joints) {
+                return Err(MetricError::Mismatch(format!("facing joint {bad} is outside the clip's {} joints", clip.joints)));
+            }
+        }
+        let scale = match features.scale {
+            Some(s) if s.is_finite() && s > 0.0 => s,
+            Some(s) => return Err(MetricError::Mismatch(format!("point features: scale {s} is not a positive number"))),
+            None if clip.frames == 0 => 1.0,
+            None => {
+                let p = clip.frame(0);
+                let bones: Vec<f64> = (0..clip.joints)
+                    .filter_map(|j| clip.parents.get(j).copied().flatten().filter(|&q| q < clip.joints).map(|q| p[j].distance(p[q])))
+                    .collect();
+                let mean = bones.iter().sum::<f64>() / bones.len().max(1) as f64;
+                if !(mean > 0.0 && mean.is_finite()) {
+                    return Err(MetricError::TooLittle(
+                        "clip: frame 0 has no bone of non-zero length to scale by (pass a scale)".to_string(),
+                    ));
+                }
+                HUMANML_MEAN_BONE_LENGTH / mean
+            }
+        };
+        let points = clip.joints - 1;
+        let mut values = Vec::with_capacity(clip.frames * points * 3);
+        let mut yaw = DQuat::IDENTITY;
+        for t in 0..clip.frames {
+            let p = clip.frame(t);
+            if let Some(forward) = features.facing.as_ref().and_then(|f| f.forward(p)) {
+                yaw = DQuat::from_rotation_y(-forward.x.atan2(forward.z));
+            }
+            let root = p[0];
+            for q in &p[1..] {
+                let v: DVec3 = yaw * (*q - root) * scale;
+                values.extend([v.x, v.y, v.z]);
+            }
+        }
+        PointClip::new(clip.frames, points * 3, values)
+    }
+
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Values per frame (3 × points).
+    pub fn dims(&self) -> usize {
+        self.dims
+    }
+
+    pub fn points(&self) -> usize {
+        self.dims / 3
+    }
+
+    /// The values of frame `f`.
+    pub fn frame(&self, f: usize) -> &[f64] {
+        &self.values[f * self.dims..(f + 1) * self.dims]
+    }
+
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+}
+
+/// Mean Euclidean distance between corresponding points of two frames (`pos_avg_l2`).
+fn frame_distance(a: &[f64], b: &[f64]) -> f64 {
+    let points = a.len() / 3;
+    let mut sum = 0.0;
+    for (p, q) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
+        let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+        sum += (dx * dx + dy * dy + dz * dz).sqrt();
+    }
+    sum / points.max(1) as f64
+}
+
+/// A clip's frames in planar layout: per frame all x, then all y, then all z, so that
+/// [`planar_distance`] runs over contiguous lanes.
+fn planar(c: &PointClip) -> Vec<f64> {
+    let points = c.points();
+    let mut out = vec![0.0; c.values.len()];
+    for (src, dst) in c.values.chunks_exact(c.dims).zip(out.chunks_exact_mut(c.dims)) {
+        for (p, xyz) in src.chunks_exact(3).enumerate() {
+            dst[p] = xyz[0];
+            dst[points + p] = xyz[1];
+            dst[2 * points + p] = xyz[2];
+        }
+    }
+    out
+}
+
+/// [`frame_distance`] of two planar frames, summed in four interleaved lanes (a fixed order,
+/// so results do not depend on the machine, and one the compiler can vectorise).
+fn planar_distance(a: &[f64], b: &[f64], points: usize) -> f64 {
+    let (ax, ayz) = a.split_at(points);
+    let (ay, az) = ayz.split_at(points);
+    let (bx, byz) = b.split_at(points);
+    let (by, bz) = byz.split_at(points);
+    let mut lanes = [0.0f64; 4];
+    let whole = points / 4 * 4;
+    for base in (0..whole).step_by(4) {
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            let i = base + l;
+            let (dx, dy, dz) = (ax[i] - bx[i], ay[i] - by[i], az[i] - bz[i]);
+            *lane += (dx * dx + dy * dy + dz * dz).sqrt();
+        }
+    }
+    for i in whole..points {
+        let (dx, dy, dz) = (ax[i] - bx[i], ay[i] - by[i], az[i] - bz[i]);
+        lanes[i - whole] += (dx * dx + dy * dy + dz * dz).sqrt();
+    }
+    ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) / points.max(1) as f64
+}
+
+/// Mean frame distance over the first `min(len)` frames (`avg_per_frame_dist`, loc norm).
+fn average_frame_distance(a: &PointClip, a0: usize, b: &PointClip, b0: usize, len: usize) -> f64 {
+    let total: f64 = (0..len).map(|t| frame_distance(a.frame(a0 + t), b.frame(b0 + t))).sum();
+    total / len.max(1) as f64
+}
+
+/// The reference's protocol constants (`eval_truebones.py`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct GenerationOptions {
+    /// Window length (frames) for coverage, local diversity and intra diversity: 15.
+    pub window: usize,
+    /// Coverage: a GT window is covered when its nearest generated window is closer than
+    /// this (mean point distance, scaled units). The reference writes `radians(20)` (its
+    /// rotation mode's 20°) and uses the same number in position mode: 0.3490658503988659.
+    pub threshold: f64,
+    /// Global diversity: shortest piece of the DP tiling: 30 frames.
+    pub min_segment: usize,
+    /// Coverage repetitions (random subsets of generated samples): 10.
+    pub reps: usize,
+    /// Random window pairs per GT clip for the GT intra diversity: 10.
+    pub gt_pairs: usize,
+    /// GT clips shorter than this are left out (the reference keeps clips of more than 20
+    /// frames): 21.
+    pub gt_min_frames: usize,
+    /// Generated samples per coverage subset; `None`: GT frames / generated frames per sample
+    /// + 1 (the reference's `n_gt_frames // 120 + 1`), at most the number of samples.
+    pub coverage_subset: Option<usize>,
+    /// Seed of every random draw (the reference evaluates with seed 10).
+    pub seed: u64,
+}
+
+impl Default for GenerationOptions {
+    fn default() -> Self {
+        GenerationOptions {
+            window: 15,
+            threshold: 20f64.to_radians(),
+            min_segment: 30,
+            reps: 10,
+            gt_pairs: 10,
+            gt_min_frames: 21,
+            coverage_subset: None,
+            seed: 10,
+        }
+    }
+}
+
+/// Mean and population standard deviation (numpy's `np.std`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct MeanStd {
+    pub mean: f64,
+    pub std: f64,
+}
+
+impl MeanStd {
+    /// Of `values` in order; `{0, 0}` for none.
+    pub fn of(values: &[f64]) -> MeanStd {
+        if values.is_empty() {
+            return MeanStd::default();
+        }
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n;
+        MeanStd { mean, std: var.sqrt() }
+    }
+}
+
+/// The metrics of one skeleton's generated samples against its GT clips.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct GenerationReport {
+    /// Percent of GT windows reproduced by generated windows; over coverage repetitions.
+    pub coverage: MeanStd,
+    /// Mean distance of generated windows to their nearest GT window; over samples.
+    pub local_diversity: MeanStd,
+    /// Mean per-frame cost of the best tiling of a sample by pieces of one GT clip (the best
+    /// clip); over samples.
+    pub global_diversity: MeanStd,
+    /// Distance between consecutive samples (cyclic); over samples.
+    pub inter_diversity: MeanStd,
+    /// Distance between two random windows of a sample; over samples.
+    pub intra_diversity: MeanStd,
+    /// The same for GT clips (`gt_pairs` per clip); over all pairs.
+    pub gt_intra_diversity: MeanStd,
+    /// |intra diversity of a sample − mean GT intra diversity|; over samples.
+    pub intra_diversity_diff: MeanStd,
+    /// Generated samples and GT clips used, GT clips left out for being short.
+    pub generated: usize,
+    pub gt: usize,
+    pub gt_dropped: usize,
+    /// Samples per coverage subset.
+    pub coverage_subset: usize,
+    /// Where the input departs from the reference's protocol (the numbers are still defined).
+    pub warnings: Vec<String>,
+}
+
+/// The paper's table row: per metric, the mean and std over skeletons of the per-skeleton
+/// means.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct GenerationAggregate {
+    pub skeletons: usize,
+    pub coverage: MeanStd,
+    pub local_diversity: MeanStd,
+    pub global_diversity: MeanStd,
+    pub inter_diversity: MeanStd,
+    pub intra_diversity: MeanStd,
+    pub gt_intra_diversity: MeanStd,
+    pub intra_diversity_diff: MeanStd,
+}
+
+/// Mean ± std over skeletons of each metric's per-skeleton mean (the reference's FINAL row).
+/// No reports give zeros.
+pub fn aggregate(reports: &[GenerationReport]) -> GenerationAggregate {
+    let over = |f: fn(&GenerationReport) -> MeanStd| MeanStd::of(&reports.iter().map(|r| f(r).mean).collect::<Vec<_>>());
+    GenerationAggregate {
+        skeletons: reports.len(),
+        coverage: over(|r| r.coverage),
+        local_diversity: over(|r| r.local_diversity),
+        global_diversity: over(|r| r.global_diversity),
+        inter_diversity: over(|r| r.inter_diversity),
+        intra_diversity: over(|r| r.intra_diversity),
+        gt_intra_diversity: over(|r| r.gt_intra_diversity),
+        intra_diversity_diff: over(|r| r.intra_diversity_diff),
+    }
+}
+
+/// Uniform integer in [0, n) (n ≥ 1), by the multiply-shift rule (bias ≤ n / 2⁶⁴).
+fn below(rng: &mut SplitMix64, n: usize) -> usize {
+    ((rng.next_u64() as u128 * n as u128) >> 64) as usize
+}
+
+/// AnyTop's generation metrics of `generated` samples against `gt` clips of one skeleton.
+///
+/// Errors: no samples or no GT clip long enough (`TooLittle`), clips with different point
+/// counts (`Mismatch`), a sample not longer than the window, or one that no GT clip can tile
+/// with pieces of at least `min_segment` frames (`TooLittle`, naming it).
+pub fn generation_metrics(
+    generated: &[PointClip],
+    gt: &[PointClip],
+    opts: &GenerationOptions,
+) -> Result<GenerationReport, MetricError> {
+    let w = opts.window;
+    if w == 0 || opts.min_segment == 0 {
+        return Err(MetricError::Mismatch("generation metrics: window and min_segment must be at least 1 frame".into()));
+    }
+    if !opts.threshold.is_finite() {
+        return Err(MetricError::NonFinite(format!("generation metrics: coverage threshold is {}", opts.threshold)));
+    }
+    let Some(first) = generated.first() else {
+        return Err(MetricError::TooLittle("generation metrics: no generated samples".into()));
+    };
+    let dims = first.dims;
+    for (what, set) in [("generated sample", generated), ("GT clip", gt)] {
+        if let Some((i, c)) = set.iter().enumerate().find(|(_, c)| c.dims != dims) {
+            return Err(MetricError::Mismatch(format!(
+                "generation metrics: {what} {i} has {} points per frame, generated sample 0 has {}",
+                c.points(),
+                dims / 3
+            )));
+        }
+    }
+    if let Some((i, c)) = generated.iter().enumerate().find(|(_, c)| c.frames <= w) {
+        return Err(MetricError::TooLittle(format!(
+            "generation metrics: generated sample {i} has {} frames; windows of {w} need at least {}",
+            c.frames,
+            w + 1
+        )));
+    }
+    let mut warnings = Vec::new();
+    let kept: Vec<&PointClip> = gt.iter().filter(|c| c.frames >= opts.gt_min_frames && c.frames > w).collect();
+    let gt_dropped = gt.len() - kept.len();
+    if gt_dropped > 0 {
+        warnings.push(format!(
+            "{gt_dropped} GT clip(s) left out for having fewer than {} frames",
+            opts.gt_min_frames.max(w + 1)
+        ));
+    }
+    if kept.is_empty() {
+        return Err(MetricError::TooLittle(format!(
+            "generation metrics: no GT clip has at least {} frames (of {} given)",
+            opts.gt_min_frames.max(w + 1),
+            gt.len()
+        )));
+    }
+    let gen_frames: usize = generated.iter().map(|c| c.frames).sum();
+    let gt_frames: usize = kept.iter().map(|c| c.frames).sum();
+    if generated.iter().any(|c| c.frames != first.frames) {
+        warnings.push("generated samples differ in length (the reference requires 120 frames each)".into());
+    }
+    if gen_frames < 2 * gt_frames {
+        warnings.push(format!(
+            "generated frames ({gen_frames}) are fewer than twice the GT frames ({gt_frames}); the reference asserts at least twice"
+        ));
+    }
+    let per_sample = (gen_frames / generated.len()).max(1);
+    let wanted_subset = opts.coverage_subset.unwrap_or(gt_frames / per_sample + 1).max(1);
+    let subset = wanted_subset.min(generated.len());
+    if subset < wanted_subset {
+        warnings.push(format!("coverage subsets hold all {subset} samples instead of {wanted_subset}"));
+    }
+
+    // Every random draw, in a fixed order: GT window pairs, sample window pairs, subsets.
+    let mut rng = SplitMix64::new(opts.seed);
+    let gt_offsets: Vec<Vec<(usize, usize)>> = kept
+        .iter()
+        .map(|c| (0..opts.gt_pairs).map(|_| (below(&mut rng, c.frames - w), below(&mut rng, c.frames - w))).collect())
+        .collect();
+    let gen_offsets: Vec<(usize, usize)> =
+        generated.iter().map(|c| (below(&mut rng, c.frames - w), below(&mut rng, c.frames - w))).collect();
+    let subsets: Vec<Vec<usize>> = (0..opts.reps)
+        .map(|_| {
+            let mut idx: Vec<usize> = (0..generated.len()).collect();
+            for i in 0..subset {
+                let j = i + below(&mut rng, idx.len() - i);
+                idx.swap(i, j);
+            }
+            idx.truncate(subset);
+            idx
+        })
+        .collect();
+
+    // GT frames, concatenated (in the planar layout of `planar`), and where each clip starts.
+    let points = dims / 3;
+    let mut gt_starts = Vec::with_capacity(kept.len());
+    let mut gt_all = Vec::with_capacity(gt_frames * dims);
+    for c in &kept {
+        gt_starts.push(gt_all.len() / dims);
+        gt_all.extend(planar(c));
+    }
+
+    // cost[i][a * gt_frames + b]: distance of sample i's frame a to GT frame b. Shared by
+    // local and global diversity and coverage.
+    let cost: Vec<Vec<f64>> = generated
+        .par_iter()
+        .map(|c| {
+            let frames = planar(c);
+            let mut m = vec![0.0; c.frames * gt_frames];
+            m.par_chunks_mut(gt_frames).enumerate().for_each(|(a, row)| {
+                let fa = &frames[a * dims..(a + 1) * dims];
+                for (out, fb) in row.iter_mut().zip(gt_all.chunks_exact(dims)) {
+                    *out = planar_distance(fa, fb, points);
+                }
+            });
+            m
+        })
+        .collect();
+
+    // Per sample: local diversity, global diversity (best GT clip), intra diversity.
+    let per_sample: Vec<Result<(f64, f64), MetricError>> = generated
+        .par_iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let m = &cost[i];
+            let windows = window_minima(m, gt_frames, 0, gt_frames, c.frames - w, w);
+            let local = windows.iter().sum::<f64>() / windows.len() as f64 / w as f64;
+            let mut best = f64::INFINITY;
+            for (k, g) in kept.iter().enumerate() {
+                best = best.min(tiling_cost(m, gt_frames, c.frames, gt_starts[k], g.frames, opts.min_segment));
+            }
+            if !best.is_finite() {
+                return Err(MetricError::TooLittle(format!(
+                    "global diversity: no GT clip tiles generated sample {i} ({} frames) with pieces of {} to the clip's length",
+                    c.frames, opts.min_segment
+                )));
+            }
+            Ok((local, best / c.frames as f64))
+        })
+        .collect();
+    let mut local = Vec::with_capacity(generated.len());
+    let mut global = Vec::with_capacity(generated.len());
+    for r in per_sample {
+        let (l, g) = r?;
+        local.push(l);
+        global.push(g);
+    }
+
+    let n = generated.len();
+    let inter: Vec<f64> = (0..n)
+        .map(|i| {
+            let (a, b) = (&generated[i], &generated[(i + n - 1) % n]);
+            average_frame_distance(a, 0, b, 0, a.frames.min(b.frames))
+        })
+        .collect();
+    let intra: Vec<f64> =
+        generated.iter().zip(&gen_offsets).map(|(c, &(a, b))| average_frame_distance(c, a, c, b, w)).collect();
+    let gt_intra: Vec<f64> = kept
+        .iter()
+        .zip(&gt_offsets)
+        .flat_map(|(c, pairs)| pairs.iter().map(move |&(a, b)| average_frame_distance(c, a, c, b, w)))
+        .collect();
+    let gt_intra_stats = MeanStd::of(&gt_intra);
+    let diff: Vec<f64> = intra.iter().map(|v| (v - gt_intra_stats.mean).abs()).collect();
+
+    // Coverage: GT windows against the concatenated subset, per repetition. The nearest
+    // window of every GT start g is found by running over target starts k and, for each,
+    // summing rows k..k+w of the cost (contiguous in g); a minimum does not depend on the
+    // order it is taken in, so chunks of k can run in parallel.
+    let gt_starts_all = gt_frames - w + 1;
+    let coverages: Vec<f64> = subsets
+        .iter()
+        .map(|subset| {
+            let rows: Vec<&[f64]> = subset
+                .iter()
+                .flat_map(|&s| cost[s].chunks_exact(gt_frames))
+                .collect();
+            let target_starts = rows.len() - w + 1;
+            let best = (0..target_starts)
+                .into_par_iter()
+                .fold(
+                    || vec![f64::INFINITY; gt_starts_all],
+                    |mut best, k| {
+                        let mut acc = vec![0.0; gt_starts_all];
+                        for t in 0..w {
+                            for (a, v) in acc.iter_mut().zip(&rows[k + t][t..t + gt_starts_all]) {
+                                *a += v;
+                            }
+                        }
+                        for (b, a) in best.iter_mut().zip(&acc) {
+                            *b = b.min(*a);
+                        }
+                        best
+                    },
+                )
+                .reduce(
+                    || vec![f64::INFINITY; gt_starts_all],
+                    |mut x, y| {
+                        for (a, b) in x.iter_mut().zip(&y) {
+                            *a = a.min(*b);
+                        }
+                        x
+                    },
+                );
+            let mut covered = 0usize;
+            let mut total = 0usize;
+            for (k, g) in kept.iter().enumerate() {
+                // Starts 0..L − w, as the reference counts them (its last start is left out).
+                let starts = &best[gt_starts[k]..gt_starts[k] + g.frames - w];
+                covered += starts.iter().filter(|&&v| v / (w as f64) < opts.threshold).count();
+                total += starts.len();
+            }
+            covered as f64 / total as f64 * 100.0
+        })
+        .collect();
+
+    Ok(GenerationReport {
+        coverage: MeanStd::of(&coverages),
+        local_diversity: MeanStd::of(&local),
+        global_diversity: MeanStd::of(&global),
+        inter_diversity: MeanStd::of(&inter),
+        intra_diversity: MeanStd::of(&intra),
+        gt_intra_diversity: gt_intra_stats,
+        intra_diversity_diff: MeanStd::of(&diff),
+        generated: n,
+        gt: kept.len(),
+        gt_dropped,
+        coverage_subset: subset,
+        warnings,
+    })
+}
+
+/// For a row-major cost matrix `m` (`cols` per row) whose source rows are windows' frames:
+/// for each start `i` in `0..starts`, the least sum over `t < w` of `m[i + t][c0 + k + t]`
+/// over target offsets `k` with the whole diagonal inside columns `c0..c0 + width`
+/// (GANimator's `group_cost[i, i + w].min()`; sums run in `t` order as the reference's).
+fn window_minima(m: &[f64], cols: usize, c0: usize, width: usize, starts: usize, w: usize) -> Vec<f64> {
+    if width < w {
+        return vec![f64::INFINITY; starts];
+    }
+    let offsets = width - w + 1;
+    (0..starts)
+        .into_par_iter()
+        .map(|i| {
+            let mut acc = vec![0.0; offsets];
+            for t in 0..w {
+                let row = &m[(i + t) * cols + c0 + t..(i + t) * cols + c0 + t + offsets];
+                for (a, v) in acc.iter_mut().zip(row) {
+                    *a += v;
+                }
+            }
+            acc.iter().copied().fold(f64::INFINITY, f64::min)
+        })
+        .collect()
+}
+
+/// GANimator's `nn_dp`: the least total cost of cutting a `len`-frame source (rows of `m`)
+/// into consecutive pieces of at least `min_segment` frames, each matched to an equally long
+/// run of target columns `c0..c0 + width`; infinite when no such tiling exists.
+fn tiling_cost(m: &[f64], cols: usize, len: usize, c0: usize, width: usize, min_segment: usize) -> f64 {
+    // g[e]: cheapest tiling of frames [0, e). Pieces [l, l + s) only feed g[l + s] with
+    // s ≥ min_segment, so g[l] is final when l is reached and the pieces starting there can be
+    // pushed forward at once: no table of piece costs is kept. Each piece's cost comes from
+    // running sums over its diagonals, grown one frame at a time.
+    let mut g = vec![f64::INFINITY; len + 1];
+    g[0] = 0.0;
+    let mut acc = vec![0.0; width];
+    for l in 0..len {
+        let longest = (len - l).min(width);
+        if longest < min_segment || !g[l].is_finite() {
+            continue;
+        }
+        acc.iter_mut().for_each(|a| *a = 0.0);
+        for s in 1..=longest {
+            // Extend every diagonal starting at target offset k by frame l + s − 1.
+            let t = s - 1;
+            let offsets = width - s + 1;
+            let row = &m[(l + t) * cols + c0 + t..(l + t) * cols + c0 + t + offsets];
+            let mut least = f64::INFINITY;
+            for (a, v) in acc[..offsets].iter_mut().zip(row) {
+                *a += v;
+                least = least.min(*a);
+            }
+            if s >= min_segment {
+                let v = g[l] + least;
+                if v < g[l + s] {
+                    g[l + s] = v;
+                }
+            }
+        }
+    }
+    g[len]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn window_minima_and_tiling_follow_their_definitions() {
+        // Source 4 frames × target 5 frames; cost = |a − b| (a diagonal match at offset 1).
+        let m: Vec<f64> = (0..4).flat_map(|a| (0..5).map(move |b| (a as f64 - b as f64 + 1.0).abs())).collect();
+        assert_eq!(window_minima(&m, 5, 0, 5, 2, 3), vec![0.0, 0.0]);
+        // Restricted to columns 2..5: the best diagonal for start 0 is offset 0 → cost 3·1.
+        assert_eq!(window_minima(&m, 5, 2, 3, 1, 3), vec![3.0]);
+        assert_eq!(tiling_cost(&m, 5, 4, 0, 5, 2), 0.0);
+        // Pieces longer than the target cannot exist.
+        assert!(tiling_cost(&m, 5, 4, 0, 1, 2).is_infinite());
+        // A 2-frame target forces two pieces of 2: rows 0-1 match it at cost 0 + 0, rows 2-3
+        // at 1 + 1; a 3-frame piece does not fit, a 1-frame piece is too short.
+        let m = [0.0, 5.0, 5.0, 0.0, 1.0, 9.0, 9.0, 1.0];
+        assert_eq!(tiling_cost(&m, 2, 4, 0, 2, 2), 2.0);
+        assert!(tiling_cost(&m, 2, 3, 0, 2, 2).is_infinite());
+        assert_eq!(tiling_cost(&m, 2, 3, 0, 2, 1), 1.0);
+    }
+
+    /// A clip whose frame t is `f(t)` (a list of points).
+    fn clip(frames: usize, f: impl Fn(usize) -> Vec<[f64; 3]>) -> PointClip {
+        let values: Vec<f64> = (0..frames).flat_map(|t| f(t).into_iter().flatten()).collect();
+        let dims = values.len() / frames.max(1);
+        PointClip::new(frames, dims, values).unwrap()
+    }
+
+    fn wave(frames: usize, phase: f64, speed: f64) -> PointClip {
+        clip(frames, |t| {
+            let x = t as f64 * speed + phase;
+            vec![[x.sin(), 1.0, 0.0], [0.5 * x.cos(), 0.5, (2.0 * x).sin()], [0.0, 0.3 * x.sin(), 1.0]]
+        })
+    }
+
+    /// Two points sliding along x by `v` per frame, frames `from..from + frames`, lifted by `lift`.
+    fn slide(from: usize, frames: usize, v: f64, lift: f64) -> PointClip {
+        clip(frames, |t| {
+            let x = (from + t) as f64 * v;
+            vec![[x, lift, 0.0], [x, 1.0 + lift, 0.0]]
+        })
+    }
+
+    fn near(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-12
+    }
+
+    #[test]
+    fn identical_sets_are_fully_covered_and_at_distance_zero() {
+        let set = vec![wave(60, 0.0, 0.2), wave(60, 1.0, 0.3), wave(60, 2.0, 0.15)];
+        let r = generation_metrics(&set, &set, &GenerationOptions::default()).unwrap();
+        assert_eq!(r.coverage, MeanStd { mean: 100.0, std: 0.0 });
+        assert!(near(r.local_diversity.mean, 0.0) && near(r.global_diversity.mean, 0.0), "{r:?}");
+        assert!(r.inter_diversity.mean > 0.1, "different clips are apart: {r:?}");
+        assert_eq!((r.generated, r.gt, r.gt_dropped, r.coverage_subset), (3, 3, 0, 3));
+        // 180 GT frames / 60 + 1 = 4 samples wanted, 3 available; and 180 < 2 × 180.
+        assert_eq!(r.warnings.len(), 2, "{:?}", r.warnings);
+    }
+
+    #[test]
+    fn a_constant_pose_has_no_diversity() {
+        let still = || clip(50, |_| vec![[0.1, 0.2, 0.3], [1.0, 0.0, -1.0]]);
+        let r = generation_metrics(&[still(), still(), still()], &[still(), still()], &GenerationOptions::default()).unwrap();
+        for (name, m) in [
+            ("local", r.local_diversity),
+            ("global", r.global_diversity),
+            ("inter", r.inter_diversity),
+            ("intra", r.intra_diversity),
+            ("gt intra", r.gt_intra_diversity),
+            ("diff", r.intra_diversity_diff),
+        ] {
+            assert_eq!(m, MeanStd::default(), "{name}");
+        }
+        assert_eq!(r.coverage.mean, 100.0);
+    }
+
+    #[test]
+    fn pieces_of_a_motion_shifted_in_time_score_as_predicted() {
+        // GT: one 100-frame slide at 0.5 per frame, so frames a and b are |a − b| / 2 apart.
+        // Generated: its frames 10..50 and 30..70, optionally lifted by 0.2 off the GT.
+        let v = 0.5;
+        let gt = [slide(0, 100, v, 0.0)];
+        for lift in [0.0, 0.2] {
+            let gen = [slide(10, 40, v, lift), slide(30, 40, v, lift)];
+            let r = generation_metrics(&gen, &gt, &GenerationOptions::default()).unwrap();
+            // Every generated window exists in the GT (at distance `lift`), so both
+            // nearest-neighbour diversities are exactly the lift.
+            assert!(near(r.local_diversity.mean, lift) && near(r.global_diversity.mean, lift), "{r:?}");
+            // The samples are 20 frames apart all along: 20 · 0.5 = 10, both ways round.
+            assert!(near(r.inter_diversity.mean, 10.0) && near(r.inter_diversity.std, 0.0), "{r:?}");
+            // GT windows starting at 10..=55 lie inside a sample (cost `lift` < 0.349); the
+            // next best diagonal is a frame off (≥ 0.5), and windows straddling the two
+            // samples jump ≥ 20 frames. Starts 0..85 are counted: 46 / 85.
+            assert!(near(r.coverage.mean, 46.0 / 85.0 * 100.0) && near(r.coverage.std, 0.0), "{r:?}");
+            // Window pairs of a slide are a whole number of frames apart (0..=24 here).
+            let steps = r.intra_diversity.mean / v * gen.len() as f64;
+            assert!((steps - steps.round()).abs() < 1e-9 && r.intra_diversity.mean <= 24.0 * v, "{r:?}");
+            assert!(r.gt_intra_diversity.mean > 0.0 && r.gt_intra_diversity.mean <= 84.0 * v, "{r:?}");
+        }
+    }
+
+    #[test]
+    fn same_seed_same_report_at_any_thread_count() {
+        let gen: Vec<PointClip> = (0..5).map(|i| wave(40, i as f64, 0.25)).collect();
+        let gt: Vec<PointClip> = (0..3).map(|i| wave(70, 0.5 + i as f64, 0.2)).collect();
+        let opts = GenerationOptions::default();
+        let json = || serde_json::to_string(&generation_metrics(&gen, &gt, &opts).unwrap()).unwrap();
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(json);
+        let three = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap().install(json);
+        assert_eq!(one, three);
+        let other = generation_metrics(&gen, &gt, &GenerationOptions { seed: 11, ..opts.clone() }).unwrap();
+        assert_ne!(serde_json::to_string(&other).unwrap(), one, "the seed drives the random windows");
+    }
+
+    #[test]
+    fn bad_and_tiny_inputs_are_typed_errors() {
+        let opts = GenerationOptions::default();
+        let gt = [wave(60, 0.0, 0.2)];
+        let too_little = |r: Result<GenerationReport, MetricError>| matches!(r, Err(MetricError::TooLittle(_)));
+        assert!(too_little(generation_metrics(&[], &gt, &opts)));
+        assert!(too_little(generation_metrics(&[wave(1, 0.0, 0.2)], &gt, &opts)), "one frame");
+        assert!(too_little(generation_metrics(&[wave(15, 0.0, 0.2)], &gt, &opts)), "window-long sample");
+        assert!(too_little(generation_metrics(&[wave(60, 0.0, 0.2)], &[wave(20, 0.0, 0.2)], &opts)), "short GT only");
+        assert!(too_little(generation_metrics(&[wave(60, 0.0, 0.2)], &[], &opts)));
+        // 20 frames cannot be cut into pieces of 30: global diversity has no value.
+        match generation_metrics(&[wave(20, 0.0, 0.2)], &gt, &opts) {
+            Err(MetricError::TooLittle(m)) => assert!(m.contains("sample 0"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+        let two_points = slide(0, 60, 0.1, 0.0);
+        assert!(matches!(generation_metrics(&[two_points], &gt, &opts), Err(MetricError::Mismatch(_))));
+        assert!(matches!(PointClip::new(2, 3, vec![0.0, 1.0, 2.0, 3.0, f64::NAN, 5.0]), Err(MetricError::NonFinite(m)) if m.contains("frame 1 value 1")));
+        assert!(matches!(PointClip::new(1, 2, vec![0.0, 1.0]), Err(MetricError::Mismatch(_))));
+        assert!(matches!(PointClip::new(2, 3, vec![0.0; 3]), Err(MetricError::Mismatch(_))));
+        // A single sample is its own neighbour: inter diversity 0, everything else defined.
+        let r = generation_metrics(&[wave(60, 0.0, 0.2)], &gt, &opts).unwrap();
+        assert_eq!(r.inter_diversity, MeanStd::default());
+        assert_eq!(r.coverage.mean, 100.0);
+    }
+
+    fn chain_clip(frames: usize, turn: f64) -> Clip {
+        // Root at height 1 walking along +x; a 2-bone neck of length 1 and 2 leaning forward
+        // (+x) and up; a body axis from joint 2 (front) to joint 0 (back); `turn` rotates the
+        // whole clip about y.
+        let q = DQuat::from_rotation_y(turn);
+        let mut positions = Vec::new();
+        for t in 0..frames {
+            let root = DVec3::new(0.1 * t as f64, 1.0, 0.0);
+            let j1 = root + DVec3::new(0.6, 0.8, 0.0);
+            let j2 = j1 + DVec3::new(2.0, 0.0, 0.0);
+            positions.extend([q * root, q * j1, q * j2]);
+        }
+        Clip {
+            frames,
+            joints: 3,
+            fps: 30.0,
+            positions,
+            parents: vec![None, Some(0), Some(1)],
+            names: vec!["root".into(), "neck".into(), "head".into()],
+            feet: vec![],
+            scale: 3.0,
+        }
+    }
+
+    #[test]
+    fn clips_become_root_relative_points_in_anytop_units_facing_forward() {
+        let s = HUMANML_MEAN_BONE_LENGTH / 1.5; // bones of 1 and 2
+        let p = PointClip::from_clip(&chain_clip(2, 0.0)).unwrap();
+        assert_eq!((p.frames(), p.points()), (2, 2));
+        let want = [0.6 * s, 0.8 * s, 0.0, 2.6 * s, 0.8 * s, 0.0];
+        for (a, b) in p.frame(1).iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{:?} vs {want:?}", p.frame(1));
+        }
+        // With a facing rule the features do not depend on which way the clip faces; the body
+        // axis points along +x, so each frame is turned a quarter to face +z.
+        let features = PointFeatures { facing: Some(Facing::BodyAxis { front: 2, back: 0 }), scale: None };
+        let a = PointClip::from_clip_with(&chain_clip(3, 0.0), &features).unwrap();
+        let b = PointClip::from_clip_with(&chain_clip(3, 1.1), &features).unwrap();
+        for (x, y) in a.values().iter().zip(b.values()) {
+            assert!((x - y).abs() < 1e-12);
+        }
+        assert!((a.frame(0)[5] - 2.6 * s).abs() < 1e-12 && a.frame(0)[3].abs() < 1e-12, "{:?}", a.frame(0));
+        let turned = PointClip::from_clip(&chain_clip(3, 1.1)).unwrap();
+        assert!(turned.values().iter().zip(a.values()).any(|(x, y)| (x - y).abs() > 0.1));
+        // Bad inputs.
+        let mut nan = chain_clip(2, 0.0);
+        nan.positions[4].y = f64::NAN;
+        assert!(matches!(PointClip::from_clip(&nan), Err(MetricError::NonFinite(m)) if m.contains("frame 1 joint 1")));
+        let far = PointFeatures { facing: Some(Facing::BodyAxis { front: 7, back: 0 }), scale: None };
+        assert!(matches!(PointClip::from_clip_with(&chain_clip(2, 0.0), &far), Err(MetricError::Mismatch(_))));
+    }
+
+    #[test]
+    fn anytop_features_give_heights_above_the_root() {
+        let mut f = vec![0.0f32; 2 * 13];
+        f[1] = 0.5;
+        f[13..16].copy_from_slice(&[1.0, 2.0, 3.0]);
+        let p = PointClip::from_anytop_features(1, 2, &f).unwrap();
+        assert_eq!(p.frame(0), &[1.0, 1.5, 3.0]);
+        assert!(matches!(PointClip::from_anytop_features(1, 2, &f[..20]), Err(MetricError::Mismatch(_))));
+        assert!(matches!(PointClip::from_anytop_features(1, 1, &f[..13]), Err(MetricError::TooLittle(_))));
+    }
+
+    #[test]
+    fn aggregate_averages_skeleton_means() {
+        let set = vec![wave(60, 0.0, 0.2), wave(60, 1.0, 0.3)];
+        let a = generation_metrics(&set, &set, &GenerationOptions::default()).unwrap();
+        let still = || clip(50, |_| vec![[0.0; 3]; 3]);
+        let b = generation_metrics(&[still(), still()], &[still()], &GenerationOptions::default()).unwrap();
+        let agg = aggregate(&[a.clone(), b]);
+        assert_eq!(agg.skeletons, 2);
+        assert!(near(agg.inter_diversity.mean, a.inter_diversity.mean / 2.0));
+        assert!(near(agg.inter_diversity.std, a.inter_diversity.mean / 2.0));
+        assert_eq!(agg.coverage, MeanStd { mean: 100.0, std: 0.0 });
+        assert_eq!(aggregate(&[]).skeletons, 0);
+    }
+}
