@@ -52,6 +52,8 @@ pub enum RetargetError {
     SourceSkeleton { joints: usize, skeleton: usize },
     #[error("the {side} skeleton has no joints")]
     EmptySkeleton { side: &'static str },
+    #[error("the {side} skeleton: {error}")]
+    Skeleton { side: &'static str, error: crate::skeleton::SkeletonError },
     #[error("{what} has zero frames")]
     ZeroFrames { what: String },
     #[error("binding pair {pair}: {side} joint index {index} is out of range (the {side} skeleton has {joints} joints)")]
@@ -228,6 +230,9 @@ impl<'a> Plan<'a> {
         }
         if key.is_empty() {
             notes.push("no source frame falls inside the output: the result is unconditioned".to_string());
+        }
+        if map.is_empty() && settings.root_motion == RootMotion::Examples {
+            notes.push("nothing is bound: the result is an unconditioned mix of the examples".to_string());
         }
         let mut known = vec![0.0f32; frames];
         for &f in &key {
@@ -529,6 +534,10 @@ fn check_inputs(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion]
     if target.is_empty() {
         return Err(RetargetError::EmptySkeleton { side: "target" });
     }
+    // Forward kinematics (position and velocity features, world rotations) needs parents
+    // before children and one root.
+    source_skeleton.validate().map_err(|error| RetargetError::Skeleton { side: "source", error })?;
+    target.validate().map_err(|error| RetargetError::Skeleton { side: "target", error })?;
     if source.joints != source_skeleton.len() || source.rotations.len() != source.frames * source.joints || source.translations.len() != source.frames * source.joints {
         return Err(RetargetError::SourceSkeleton { joints: source.joints, skeleton: source_skeleton.len() });
     }
