@@ -480,8 +480,7 @@ impl<'a> Plan<'a> {
             if bound.is_empty() {
                 continue;
             }
-            for t in 0..len {
-                let k = known[t];
+            for (t, &k) in known.iter().enumerate().take(len) {
                 if k <= 0.0 {
                     continue;
                 }
