@@ -5,9 +5,10 @@
 //! * the demo: Flamingo_Walk (79 frames) -> one Monkey walk (61 frames), 6 bound bones, the
 //!   reference's binding, at the reference demo's alpha 0.9 and at the paper's 0.85;
 //! * long sources: the Flamingo clip repeated 8x and 64x (632 and 5056 frames);
-//! * several example clips: the Monkey clip 4x and 16x;
-//! each on one thread and on all threads. When ../shared/data is absent the rows use the
-//! project's synthetic biped -> quadruped instead.
+//! * several example clips: the Monkey clip 4x and 16x.
+//!
+//! Each row runs on one thread (wall and on-CPU time) and on all threads. When ../shared/data
+//! is absent the rows use the project's synthetic biped -> quadruped instead.
 //!
 //! Then, for the demo, how our output compares with the reference's output BVH (seed 0, alpha
 //! 0.9, default and copy mode): frames, root height range, mean joint position error.
