@@ -148,11 +148,18 @@ pub fn retarget_samples(source: &Motion, source_skeleton: &Skeleton, examples: &
     seeds.par_iter().map(|&seed| plan.run(seed, Instant::now(), prepare)).collect()
 }
 
+/// Most frames `resample` produces (a day at 1000 fps is far beyond any clip).
+pub const RESAMPLE_MAX_FRAMES: usize = 100_000_000;
+
 /// `motion` at `fps` frames per second over the same duration: rotations slerped, translations
 /// interpolated linearly. A one-frame motion only changes its frame time; a motion without a
-/// valid frame time or a non-positive `fps` is returned unchanged.
+/// valid frame time, a non-positive `fps`, or a rate that would give more than
+/// `RESAMPLE_MAX_FRAMES` frames returns the motion unchanged (callers compare frame times).
 pub fn resample(motion: &Motion, fps: f64) -> Motion {
     if !(fps.is_finite() && fps > 0.0 && motion.frame_time.is_finite() && motion.frame_time > 0.0) {
+        return motion.clone();
+    }
+    if motion.frames.saturating_sub(1) as f64 * motion.frame_time * fps >= RESAMPLE_MAX_FRAMES as f64 {
         return motion.clone();
     }
     let j = motion.joints;

@@ -278,5 +278,6 @@ fn resample_keeps_duration_and_endpoints() {
     let same = resample(&m, 1.0 / m.frame_time);
     assert_eq!(same.frames, m.frames);
     assert_eq!(resample(&m, 0.0), m);
+    assert_eq!(resample(&m, 1e300), m);
     assert_eq!(resample(&m.first_frames(1), 60.0).frames, 1);
 }
