@@ -5,9 +5,10 @@
 //! * the demo: Flamingo_Walk (79 frames) -> one Monkey walk (61 frames), 6 bound bones, the
 //!   reference's binding, at the reference demo's alpha 0.9 and at the paper's 0.85;
 //! * long sources: the Flamingo clip repeated 8x and 64x (632 and 5056 frames);
-//! * several example clips: the Monkey clip 4x and 16x;
-//! each on one thread and on all threads. When ../shared/data is absent the rows use the
-//! project's synthetic biped -> quadruped instead.
+//! * several example clips: the Monkey clip 4x and 16x.
+//!
+//! Each row runs on one thread (wall and on-CPU time) and on all threads. When ../shared/data
+//! is absent the rows use the project's synthetic biped -> quadruped instead.
 //!
 //! Then, for the demo, how our output compares with the reference's output BVH (seed 0, alpha
 //! 0.9, default and copy mode): frames, root height range, mean joint position error.
@@ -88,17 +89,24 @@ fn thread_cpu_ms() -> Option<f64> {
     Some(text.split_whitespace().next()?.parse::<f64>().ok()? / 1e6)
 }
 
-/// Median on-CPU ms of `retarget` on one thread (`None` without schedstat).
+/// Median on-CPU ms of `retarget` on one thread (`None` without schedstat). The kernel may
+/// account CPU time in scheduler ticks (4 ms here), so each sample times enough runs to span
+/// about 100 ticks and divides.
 fn cpu_time(case: &Case, source: &Motion, examples: &[Motion], settings: &Settings) -> Option<f64> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     pool.install(|| {
         let run = || black_box(retarget(source, &case.source_skeleton, examples, &case.target, &case.map, settings).unwrap());
+        let start = std::time::Instant::now();
         run();
+        let once = start.elapsed().as_secs_f64() * 1e3;
+        let batch = ((400.0 / once.max(1e-3)).ceil() as usize).clamp(1, 1000);
         let mut t: Vec<f64> = Vec::new();
         for _ in 0..RUNS {
             let start = thread_cpu_ms()?;
-            run();
-            t.push(thread_cpu_ms()? - start);
+            for _ in 0..batch {
+                run();
+            }
+            t.push((thread_cpu_ms()? - start) / batch as f64);
         }
         t.sort_by(f64::total_cmp);
         Some(t[t.len() / 2])

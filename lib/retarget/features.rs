@@ -141,7 +141,7 @@ pub(crate) fn rotation_features(motion: &Motion, scale: f64) -> Channels {
     let j = motion.joints;
     let mut out = Channels::zeros(motion.frames, rotation_width(j));
     let root = root_track(motion, scale);
-    for f in 0..motion.frames {
+    for (f, track) in root.iter().enumerate() {
         let row = out.row_mut(f);
         for k in 0..j {
             let six = m2m::rotation_to_6d(motion.rotations[f * j + k]);
@@ -149,7 +149,7 @@ pub(crate) fn rotation_features(motion: &Motion, scale: f64) -> Channels {
                 *slot = v as f32;
             }
         }
-        row[6 * j..].copy_from_slice(&root[f]);
+        row[6 * j..].copy_from_slice(track);
     }
     out
 }

@@ -52,6 +52,8 @@ pub enum RetargetError {
     SourceSkeleton { joints: usize, skeleton: usize },
     #[error("the {side} skeleton has no joints")]
     EmptySkeleton { side: &'static str },
+    #[error("the {side} skeleton: {error}")]
+    Skeleton { side: &'static str, error: crate::skeleton::SkeletonError },
     #[error("{what} has zero frames")]
     ZeroFrames { what: String },
     #[error("binding pair {pair}: {side} joint index {index} is out of range (the {side} skeleton has {joints} joints)")]
@@ -146,11 +148,18 @@ pub fn retarget_samples(source: &Motion, source_skeleton: &Skeleton, examples: &
     seeds.par_iter().map(|&seed| plan.run(seed, Instant::now(), prepare)).collect()
 }
 
+/// Most frames `resample` produces (a day at 1000 fps is far beyond any clip).
+pub const RESAMPLE_MAX_FRAMES: usize = 100_000_000;
+
 /// `motion` at `fps` frames per second over the same duration: rotations slerped, translations
 /// interpolated linearly. A one-frame motion only changes its frame time; a motion without a
-/// valid frame time or a non-positive `fps` is returned unchanged.
+/// valid frame time, a non-positive `fps`, or a rate that would give more than
+/// `RESAMPLE_MAX_FRAMES` frames returns the motion unchanged (callers compare frame times).
 pub fn resample(motion: &Motion, fps: f64) -> Motion {
     if !(fps.is_finite() && fps > 0.0 && motion.frame_time.is_finite() && motion.frame_time > 0.0) {
+        return motion.clone();
+    }
+    if motion.frames.saturating_sub(1) as f64 * motion.frame_time * fps >= RESAMPLE_MAX_FRAMES as f64 {
         return motion.clone();
     }
     let j = motion.joints;
@@ -228,6 +237,9 @@ impl<'a> Plan<'a> {
         }
         if key.is_empty() {
             notes.push("no source frame falls inside the output: the result is unconditioned".to_string());
+        }
+        if map.is_empty() && settings.root_motion == RootMotion::Examples {
+            notes.push("nothing is bound: the result is an unconditioned mix of the examples".to_string());
         }
         let mut known = vec![0.0f32; frames];
         for &f in &key {
@@ -475,8 +487,7 @@ impl<'a> Plan<'a> {
             if bound.is_empty() {
                 continue;
             }
-            for t in 0..len {
-                let k = known[t];
+            for (t, &k) in known.iter().enumerate().take(len) {
                 if k <= 0.0 {
                     continue;
                 }
@@ -529,6 +540,10 @@ fn check_inputs(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion]
     if target.is_empty() {
         return Err(RetargetError::EmptySkeleton { side: "target" });
     }
+    // Forward kinematics (position and velocity features, world rotations) needs parents
+    // before children and one root.
+    source_skeleton.validate().map_err(|error| RetargetError::Skeleton { side: "source", error })?;
+    target.validate().map_err(|error| RetargetError::Skeleton { side: "target", error })?;
     if source.joints != source_skeleton.len() || source.rotations.len() != source.frames * source.joints || source.translations.len() != source.frames * source.joints {
         return Err(RetargetError::SourceSkeleton { joints: source.joints, skeleton: source_skeleton.len() });
     }

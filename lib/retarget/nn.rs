@@ -246,6 +246,11 @@ fn distances(q: &Query, bank: &Bank, i0: usize, i1: usize, out: &mut [f32], scra
 /// patch (with GenMM's completeness normalisation when `completeness` is set), and every frame
 /// becomes the average of the chosen patches covering it.
 pub(crate) fn step(state: &Channels, bank: &Bank, weights: &[f32], completeness: Option<f32>) -> StepResult {
+    step_with_limit(state, bank, weights, completeness, MAX_STORED)
+}
+
+/// `step`, keeping the distance matrix only when it has at most `max_stored` entries.
+fn step_with_limit(state: &Channels, bank: &Bank, weights: &[f32], completeness: Option<f32>, max_stored: usize) -> StepResult {
     let p = bank.patch;
     let (weighted, frame_norms) = weigh(state, weights, bank.stride);
     let q = Query { weighted, norms: window_sums(&frame_norms, p), frames: state.frames };
@@ -253,7 +258,7 @@ pub(crate) fn step(state: &Channels, bank: &Bank, weights: &[f32], completeness:
     let ny = bank.len();
     let blocks: Vec<(usize, usize)> = (0..nq).step_by(BLOCK).map(|i| (i, (i + BLOCK).min(nq))).collect();
 
-    let nn: Vec<(usize, f32)> = if nq * ny <= MAX_STORED {
+    let nn: Vec<(usize, f32)> = if nq * ny <= max_stored {
         let mut d = vec![0.0f32; nq * ny];
         d.par_chunks_mut(BLOCK * ny).zip(&blocks).for_each_init(Vec::new, |scratch, (out, &(i0, i1))| distances(&q, bank, i0, i1, out, scratch));
         let norm = column_normalisers(completeness, ny, d.chunks(ny));
@@ -413,6 +418,20 @@ mod tests {
                 assert_eq!(g[r * 7 + c].to_bits(), dot(row(&a, r, stride), row(&b, c, stride)).to_bits(), "{r} {c}");
             }
         }
+    }
+
+    #[test]
+    fn stored_and_recomputed_distances_agree() {
+        let w = 13;
+        let weights: Vec<f32> = (0..w).map(|k| if k < 4 { 0.85 } else { 0.15 }).collect();
+        let clips: Vec<Channels> = (0..3).map(|c| channels(40 + 7 * c, w, |t, k| ((t * (3 + c) + k * 5) as f32 * 0.11).sin())).collect();
+        let payload = clips.iter().map(|c| Channels::zeros(c.frames, 0)).collect();
+        let bank = Bank::new(clips, payload, &weights, 5);
+        let state = channels(300, w, |t, k| ((t * 7 + k) as f32 * 0.05).cos());
+        let stored = step_with_limit(&state, &bank, &weights, Some(0.01), usize::MAX);
+        let recomputed = step_with_limit(&state, &bank, &weights, Some(0.01), 0);
+        assert_eq!(stored.matched, recomputed.matched);
+        assert_eq!(stored.cost.to_bits(), recomputed.cost.to_bits());
     }
 
     #[test]

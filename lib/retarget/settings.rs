@@ -107,6 +107,9 @@ impl Settings {
         if self.patch == 0 {
             return bad("patch", "0".into(), "at least 1 frame");
         }
+        if self.steps == 0 {
+            return bad("steps", "0".into(), "at least 1 matching step per level");
+        }
         if !(0.0..=1.0).contains(&self.alpha) {
             return bad("alpha", self.alpha.to_string(), "a weight in [0, 1]");
         }

@@ -241,6 +241,7 @@ fn errors_are_typed_and_clear() {
         (Settings { alpha: 1.5, ..d.clone() }, "alpha = 1.5"),
         (Settings { pyramid: 1.0, ..d.clone() }, "pyramid = 1"),
         (Settings { patch: 0, ..d.clone() }, "patch = 0"),
+        (Settings { steps: 0, ..d.clone() }, "steps = 0"),
         (Settings { noise_sigma: f64::NAN, ..d.clone() }, "noise_sigma = NaN"),
         (Settings { completeness: Some(0.0), ..d.clone() }, "completeness = 0"),
         (Settings { frames: Some(0), ..d.clone() }, "the requested output has zero frames"),
@@ -250,6 +251,12 @@ fn errors_are_typed_and_clear() {
     }
     let empty = Skeleton { joints: vec![], frame_time: 0.1 };
     assert!(err(retarget(&sm, &ss, &[tm.clone()], &empty, &map, &d)).contains("the target skeleton has no joints"));
+    let mut tangled = ts.clone();
+    tangled.joints[1].parent = Some(5);
+    assert!(err(retarget(&sm, &ss, &[tm.clone()], &tangled, &map, &d)).contains("the target skeleton: joint 1"));
+    // An empty binding is allowed (unconditioned synthesis) and says so.
+    let r = retarget(&sm, &ss, &[tm.clone()], &ts, &vec![], &d).unwrap();
+    assert!(r.report.notes.iter().any(|n| n.contains("nothing is bound")));
 }
 
 #[test]
@@ -271,5 +278,6 @@ fn resample_keeps_duration_and_endpoints() {
     let same = resample(&m, 1.0 / m.frame_time);
     assert_eq!(same.frames, m.frames);
     assert_eq!(resample(&m, 0.0), m);
+    assert_eq!(resample(&m, 1e300), m);
     assert_eq!(resample(&m.first_frames(1), 60.0).frames, 1);
 }
