@@ -1,0 +1,97 @@
+//! Picture rendering time: `cargo bench --bench render`.
+//!
+//! Issue 6 asks that a 1000-frame, 86-joint motion renders to a contact sheet or a GIF in well
+//! under a second. The motion is the Monkey walk of `../shared/data/bvh/truebones_motion2motion`
+//! (86 joints) when the corpus is present, else the project's spider, repeated to 1000 frames.
+//! The table gives the median of `RUNS` runs, one thread.
+//!
+//! With `RENDER_LOOK_DIR=/some/dir` it also writes a sheet and a GIF of every creature in
+//! `examples/data` and of a few corpus files there, for looking at.
+
+mod common;
+use common::{median, ms, time_runs, RUNS};
+
+use menagerie::bvh;
+use menagerie::motion::Motion;
+use menagerie::render::camera::Framing;
+use menagerie::render::gif::{render_gif, GifOptions};
+use menagerie::render::sheet::{render_sheet, SheetOptions};
+use menagerie::render::{Legend, Track, View};
+use menagerie::skeleton::Skeleton;
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+
+fn load(path: &Path) -> Track {
+    let bytes = std::fs::read(path).unwrap();
+    let name = path.file_name().unwrap().to_string_lossy().to_string();
+    let parsed = bvh::parse_bytes(&bytes, &name).unwrap();
+    let skeleton = Skeleton::from_bvh(&parsed);
+    let motion = Motion::from_bvh(&parsed, &skeleton);
+    Track::from_motion(&name, &skeleton, &motion)
+}
+
+/// `track` played over and over until it has `frames` frames.
+fn repeated(track: &Track, frames: usize) -> Track {
+    let mut t = track.clone();
+    t.positions = track.positions.iter().cycle().take(frames * track.points()).copied().collect();
+    t.frames = frames;
+    t
+}
+
+fn look(root: &Path, dir: &Path) {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut files: Vec<PathBuf> = common::bvh_files(&root.join("examples/data"));
+    let corpus = root.join("../shared/data/bvh");
+    for f in [
+        "lafan1/walk1_subject1.bvh",
+        "cmu_bvh11/131_01.bvh",
+        "dog_mann/Dog/D1_001_KAN01_001.bvh",
+        "truebones_motion2motion/Monkey/__Walk.bvh",
+        "truebones_anytop/Chicken/Chicken_IdlePecking.bvh",
+    ] {
+        if corpus.join(f).is_file() {
+            files.push(corpus.join(f));
+        }
+    }
+    let legend = Legend::default();
+    for f in files {
+        let track = load(&f);
+        let stem = f.file_stem().unwrap().to_string_lossy().to_string();
+        let sheet = render_sheet(std::slice::from_ref(&track), &legend, &SheetOptions::default()).unwrap();
+        std::fs::write(dir.join(format!("{stem}.png")), sheet).unwrap();
+        let fixed = SheetOptions { framing: Framing::Fixed, ..Default::default() };
+        std::fs::write(dir.join(format!("{stem}-fixed.png")), render_sheet(std::slice::from_ref(&track), &legend, &fixed).unwrap()).unwrap();
+        let short = Track { frames: track.frames.min(240), positions: track.positions[..track.frames.min(240) * track.points()].to_vec(), ..track };
+        std::fs::write(dir.join(format!("{stem}.gif")), render_gif(&[short], &legend, &GifOptions::default()).unwrap()).unwrap();
+        println!("wrote {stem}.png, {stem}-fixed.png, {stem}.gif");
+    }
+}
+
+fn main() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    if let Some(dir) = std::env::var_os("RENDER_LOOK_DIR") {
+        look(root, Path::new(&dir));
+    }
+    let monkey = root.join("../shared/data/bvh/truebones_motion2motion/Monkey/__Walk.bvh");
+    let (source, base) = if monkey.is_file() {
+        ("Monkey __Walk (corpus)", load(&monkey))
+    } else {
+        println!("note: ../shared/data absent, using examples/data/spider.bvh");
+        ("spider (examples)", load(&root.join("examples/data/spider.bvh")))
+    };
+    let track = repeated(&base, 1000);
+    let tracks = [track];
+    let legend = Legend::default();
+    println!("render: {source}, {} frames, {} points; median of {RUNS} runs, one thread", tracks[0].frames, tracks[0].points());
+    println!("| picture | framing | median ms | bytes |");
+    println!("|---|---|---:|---:|");
+    for framing in [Framing::Follow, Framing::Fixed] {
+        let opts = SheetOptions { framing, view: View::Auto, ..Default::default() };
+        let mut size = 0;
+        let t = time_runs(|| size = black_box(render_sheet(&tracks, &legend, &opts).unwrap()).len());
+        println!("| sheet 10x3 cells 160 px | {framing:?} | {:.1} | {size} |", ms(median(&t)));
+        let opts = GifOptions { framing, ..Default::default() };
+        let t = time_runs(|| size = black_box(render_gif(&tracks, &legend, &opts).unwrap()).len());
+        println!("| GIF 256 px, 1000 frames | {framing:?} | {:.1} | {size} |", ms(median(&t)));
+    }
+}
