@@ -67,6 +67,26 @@ fn look(root: &Path, dir: &Path) {
     }
 }
 
+/// CPU time of this thread in ns (Linux), so a busy machine does not inflate the numbers the
+/// issue states in CPU time; `None` elsewhere.
+fn thread_cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat").ok()?.split_whitespace().next()?.parse().ok()
+}
+
+/// Median wall time and median CPU time (ms) of `RUNS` runs of `f`.
+fn measure(mut f: impl FnMut()) -> (f64, Option<f64>) {
+    let mut cpu = Vec::new();
+    let wall = time_runs(|| {
+        let c0 = thread_cpu_ns();
+        f();
+        if let (Some(a), Some(b)) = (c0, thread_cpu_ns()) {
+            cpu.push(b - a);
+        }
+    });
+    cpu.sort();
+    (ms(median(&wall)), cpu.get(cpu.len() / 2).map(|&ns| ns as f64 / 1e6))
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     if let Some(dir) = std::env::var_os("RENDER_LOOK_DIR") {
@@ -83,15 +103,16 @@ fn main() {
     let tracks = [track];
     let legend = Legend::default();
     println!("render: {source}, {} frames, {} points; median of {RUNS} runs, one thread", tracks[0].frames, tracks[0].points());
-    println!("| picture | framing | median ms | bytes |");
-    println!("|---|---|---:|---:|");
+    println!("| picture | framing | median wall ms | median CPU ms | bytes |");
+    println!("|---|---|---:|---:|---:|");
+    let cpu = |c: Option<f64>| c.map_or("-".to_string(), |c| format!("{c:.1}"));
     for framing in [Framing::Follow, Framing::Fixed] {
         let opts = SheetOptions { framing, view: View::Auto, ..Default::default() };
         let mut size = 0;
-        let t = time_runs(|| size = black_box(render_sheet(&tracks, &legend, &opts).unwrap()).len());
-        println!("| sheet 10x3 cells 160 px | {framing:?} | {:.1} | {size} |", ms(median(&t)));
+        let (wall, c) = measure(|| size = black_box(render_sheet(&tracks, &legend, &opts).unwrap()).len());
+        println!("| sheet 10x3 cells 160 px | {framing:?} | {wall:.1} | {} | {size} |", cpu(c));
         let opts = GifOptions { framing, ..Default::default() };
-        let t = time_runs(|| size = black_box(render_gif(&tracks, &legend, &opts).unwrap()).len());
-        println!("| GIF 256 px, 1000 frames | {framing:?} | {:.1} | {size} |", ms(median(&t)));
+        let (wall, c) = measure(|| size = black_box(render_gif(&tracks, &legend, &opts).unwrap()).len());
+        println!("| GIF 256 px, 1000 frames | {framing:?} | {wall:.1} | {} | {size} |", cpu(c));
     }
 }

@@ -78,36 +78,133 @@ fn gif_palette() -> Vec<Rgb> {
     colours
 }
 
-/// Exact colour -> palette index, remembered in a small direct-mapped cache (a picture has a
-/// few hundred distinct colours, each searched once).
+/// Colour -> palette index through a table of 6 bits per channel, filled on first use of each
+/// cell (a picture touches a few thousand cells; anti-aliased edges make many distinct colours,
+/// so searching the palette per exact colour was the slowest part of encoding). Palette
+/// colours are entered first so they map to themselves.
 struct Quantiser {
     palette: Vec<Rgb>,
-    cache: Vec<(u32, u8)>,
+    table: Vec<u8>,
+}
+
+const UNSET: u8 = TRANSPARENT;
+
+#[inline]
+fn cell(c: &[u8]) -> usize {
+    ((c[0] as usize >> 2) << 12) | ((c[1] as usize >> 2) << 6) | (c[2] as usize >> 2)
 }
 
 impl Quantiser {
     fn new(palette: Vec<Rgb>) -> Quantiser {
-        Quantiser { palette, cache: vec![(u32::MAX, 0); 4096] }
+        let mut table = vec![UNSET; 1 << 18];
+        for (i, c) in palette.iter().enumerate().rev() {
+            table[cell(c)] = i as u8;
+        }
+        Quantiser { palette, table }
     }
 
     #[inline]
     fn index(&mut self, c: &[u8]) -> u8 {
-        let key = (c[0] as u32) << 16 | (c[1] as u32) << 8 | c[2] as u32;
-        let slot = (key.wrapping_mul(0x9E37_79B1) >> 20) as usize;
-        if self.cache[slot].0 == key {
-            return self.cache[slot].1;
+        let k = cell(c);
+        let v = self.table[k];
+        if v != UNSET {
+            return v;
         }
+        // Nearest palette colour to the cell's centre.
+        let centre = [c[0] | 2, c[1] | 2, c[2] | 2];
         let mut best = (u32::MAX, 0u8);
         for (i, p) in self.palette.iter().enumerate() {
             let d = |a: u8, b: u8| (a as i32 - b as i32).pow(2) as u32;
             // Green weighs most, blue least, roughly as the eye does.
-            let dist = 3 * d(c[0], p[0]) + 4 * d(c[1], p[1]) + 2 * d(c[2], p[2]);
+            let dist = 3 * d(centre[0], p[0]) + 4 * d(centre[1], p[1]) + 2 * d(centre[2], p[2]);
             if dist < best.0 {
                 best = (dist, i as u8);
             }
         }
-        self.cache[slot] = (key, best.1);
+        self.table[k] = best.1;
         best.1
+    }
+}
+
+/// GIF's LZW compression (variable-width codes, least significant bit first), written here
+/// because the frames are mostly long runs of the transparent index and a direct child table
+/// (no hashing) compresses them several times faster than a general encoder. Returns the
+/// minimum code size byte followed by the codes, as [`gif::Encoder::write_lzw_pre_encoded_frame`]
+/// expects. `children` is reused between frames; entries set here are cleared before returning.
+struct Lzw {
+    /// `children[code * 256 + byte]`: the code for `code`'s string followed by `byte` (0 = none;
+    /// no code below the first free one is ever a child).
+    children: Vec<u16>,
+    used: Vec<u32>,
+}
+
+const MIN_CODE_SIZE: u8 = 8;
+
+impl Lzw {
+    fn new() -> Lzw {
+        Lzw { children: vec![0; 4096 * 256], used: Vec::with_capacity(4096) }
+    }
+
+    fn reset(&mut self) {
+        for &slot in &self.used {
+            self.children[slot as usize] = 0;
+        }
+        self.used.clear();
+    }
+
+    fn encode(&mut self, data: &[u8]) -> Vec<u8> {
+        let clear = 1u32 << MIN_CODE_SIZE;
+        let end = clear + 1;
+        let mut out = Vec::with_capacity(data.len() / 4 + 16);
+        out.push(MIN_CODE_SIZE);
+        let (mut acc, mut bits) = (0u64, 0u32);
+        let mut emit = |code: u32, width: u32, out: &mut Vec<u8>| {
+            acc |= (code as u64) << bits;
+            bits += width;
+            while bits >= 8 {
+                out.push(acc as u8);
+                acc >>= 8;
+                bits -= 8;
+            }
+        };
+        let mut width = MIN_CODE_SIZE as u32 + 1;
+        let mut next = end + 1;
+        emit(clear, width, &mut out);
+        if let Some((&first, rest)) = data.split_first() {
+            let mut prefix = first as u32;
+            for &b in rest {
+                let slot = (prefix as usize) << 8 | b as usize;
+                let child = self.children[slot];
+                if child != 0 {
+                    prefix = child as u32;
+                    continue;
+                }
+                emit(prefix, width, &mut out);
+                if next < 4096 {
+                    self.children[slot] = next as u16;
+                    self.used.push(slot as u32);
+                    next += 1;
+                    // The decoder adds this entry one code later, so it widens when `next`
+                    // passes the width's range, not when it reaches it.
+                    if next > (1 << width) && width < 12 {
+                        width += 1;
+                    }
+                } else {
+                    emit(clear, width, &mut out);
+                    self.reset();
+                    width = MIN_CODE_SIZE as u32 + 1;
+                    next = end + 1;
+                }
+                prefix = b as u32;
+            }
+            emit(prefix, width, &mut out);
+        }
+        emit(end, width, &mut out);
+        if bits > 0 {
+            out.push(acc as u8);
+        }
+        self.reset();
+        out
     }
 }
 
@@ -175,6 +272,7 @@ pub fn render_gif(tracks: &[Track], legend: &Legend, opts: &GifOptions) -> Resul
     let mut prev = base.clone();
     let mut scratch = Vec::new();
     let mut pending: Option<gif::Frame<'static>> = None;
+    let mut lzw = Lzw::new();
     let centis = |i: usize| (i as f64 * dt * 100.0).round() as u64;
     for i in 0..shown {
         cur.pixels.copy_from_slice(&base.pixels);
@@ -199,8 +297,9 @@ pub fn render_gif(tracks: &[Track], legend: &Legend, opts: &GifOptions) -> Resul
         };
         match frame {
             Some(frame) => {
-                if let Some(done) = pending.replace(frame) {
-                    encoder.write_frame(&done).map_err(fail)?;
+                if let Some(mut done) = pending.replace(frame) {
+                    done.buffer = Cow::Owned(lzw.encode(&done.buffer));
+                    encoder.write_lzw_pre_encoded_frame(&done).map_err(fail)?;
                 }
             }
             // Nothing moved: show the previous frame longer.
@@ -212,8 +311,9 @@ pub fn render_gif(tracks: &[Track], legend: &Legend, opts: &GifOptions) -> Resul
         }
         std::mem::swap(&mut cur, &mut prev);
     }
-    if let Some(done) = pending {
-        encoder.write_frame(&done).map_err(fail)?;
+    if let Some(mut done) = pending {
+        done.buffer = Cow::Owned(lzw.encode(&done.buffer));
+        encoder.write_lzw_pre_encoded_frame(&done).map_err(fail)?;
     }
     encoder.into_inner().map_err(fail)
 }
@@ -335,12 +435,47 @@ mod tests {
     }
 
     #[test]
+    fn our_lzw_round_trips_through_the_gif_decoder() {
+        // Runs, noise, and enough distinct strings to fill the code table several times.
+        let mut data = vec![TRANSPARENT; 5000];
+        let mut x = 12345u32;
+        for _ in 0..60_000 {
+            x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            data.push((x >> 16) as u8);
+        }
+        data.extend(std::iter::repeat_n(7u8, 3000));
+        let (w, h) = (500u16, (data.len() / 500) as u16);
+        data.truncate(w as usize * h as usize);
+        let mut lzw = Lzw::new();
+        let mut out = Vec::new();
+        {
+            let flat: Vec<u8> = (0..=255u8).flat_map(|v| [v, v, v]).collect();
+            let mut e = gif::Encoder::new(&mut out, w, h, &flat).unwrap();
+            for _ in 0..2 {
+                let frame = gif::Frame { width: w, height: h, buffer: Cow::Owned(lzw.encode(&data)), ..gif::Frame::default() };
+                e.write_lzw_pre_encoded_frame(&frame).unwrap();
+            }
+        }
+        let mut options = gif::DecodeOptions::new();
+        options.set_color_output(gif::ColorOutput::Indexed);
+        let mut d = options.read_info(std::io::Cursor::new(&out)).unwrap();
+        for _ in 0..2 {
+            let f = d.read_next_frame().unwrap().unwrap();
+            assert!(f.buffer.as_ref() == data.as_slice(), "decoded pixels differ");
+        }
+        assert!(lzw.encode(&[]).len() >= 2);
+    }
+
+    #[test]
     fn palette_fits_with_room_for_transparency() {
         let p = gif_palette();
         assert!(p.len() <= 255 && p.len() > 100, "{}", p.len());
         let mut q = Quantiser::new(p.clone());
-        for (i, c) in p.iter().enumerate() {
-            assert_eq!(q.index(c) as usize, i);
+        // Palette colours map to themselves unless another one shares their table cell.
+        let exact = p.iter().enumerate().filter(|(i, c)| q.index(c.as_slice()) as usize == *i).count();
+        assert!(exact + 10 >= p.len(), "only {exact} of {} palette colours map to themselves", p.len());
+        for c in [BACKGROUND, BONE, FOOT, sheet::tinted(palette(0))] {
+            assert_eq!(p[q.index(&c) as usize], c);
         }
     }
 }
