@@ -170,19 +170,38 @@ impl Lzw {
         let mut width = MIN_CODE_SIZE as u32 + 1;
         let mut next = end + 1;
         emit(clear, width, &mut out);
-        if let Some((&first, rest)) = data.split_first() {
+        if let Some(&first) = data.first() {
+            // Strings of nothing but the transparent index: `runs[k]` is the code of k + 1 of
+            // them. Frames are mostly such runs, and the longest known run can be found
+            // without walking the table byte by byte (same codes as the byte-wise walk).
+            let mut runs: Vec<u16> = vec![TRANSPARENT as u16];
             let mut prefix = first as u32;
-            for &b in rest {
+            let mut prefix_run = usize::from(first == TRANSPARENT);
+            let mut i = 1;
+            while i < data.len() {
+                let b = data[i];
+                if prefix_run > 0 && b == TRANSPARENT && prefix_run < runs.len() {
+                    let ahead = data[i..].iter().take(runs.len() - prefix_run).take_while(|&&x| x == TRANSPARENT).count();
+                    prefix_run += ahead;
+                    prefix = runs[prefix_run - 1] as u32;
+                    i += ahead;
+                    continue;
+                }
                 let slot = (prefix as usize) << 8 | b as usize;
                 let child = self.children[slot];
                 if child != 0 {
                     prefix = child as u32;
+                    prefix_run = 0;
+                    i += 1;
                     continue;
                 }
                 emit(prefix, width, &mut out);
                 if next < 4096 {
                     self.children[slot] = next as u16;
                     self.used.push(slot as u32);
+                    if prefix_run > 0 && b == TRANSPARENT {
+                        runs.push(next as u16);
+                    }
                     next += 1;
                     // The decoder adds this entry one code later, so it widens when `next`
                     // passes the width's range, not when it reaches it.
@@ -192,10 +211,13 @@ impl Lzw {
                 } else {
                     emit(clear, width, &mut out);
                     self.reset();
+                    runs.truncate(1);
                     width = MIN_CODE_SIZE as u32 + 1;
                     next = end + 1;
                 }
                 prefix = b as u32;
+                prefix_run = usize::from(b == TRANSPARENT);
+                i += 1;
             }
             emit(prefix, width, &mut out);
         }
@@ -342,7 +364,9 @@ fn changed_frame(cur: &Canvas, prev: &Canvas, quantiser: &mut Quantiser, delay: 
         let a = &cur.pixels[y * stride + x0 * 3..y * stride + x1 * 3];
         let b = &prev.pixels[y * stride + x0 * 3..y * stride + x1 * 3];
         for (p, q) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
-            buffer.push(if p == q { TRANSPARENT } else { quantiser.index(p) });
+            // Fixed-size arrays compare inline (slices would call memcmp per pixel).
+            let (p3, q3): ([u8; 3], [u8; 3]) = (p.try_into().unwrap_or_default(), q.try_into().unwrap_or_default());
+            buffer.push(if p3 == q3 { TRANSPARENT } else { quantiser.index(&p3) });
         }
     }
     Some(gif::Frame {
@@ -444,6 +468,10 @@ mod tests {
             data.push((x >> 16) as u8);
         }
         data.extend(std::iter::repeat_n(7u8, 3000));
+        for k in 0..3000usize {
+            data.extend(std::iter::repeat_n(TRANSPARENT, k % 97));
+            data.push((k % 5) as u8);
+        }
         let (w, h) = (500u16, (data.len() / 500) as u16);
         data.truncate(w as usize * h as usize);
         let mut lzw = Lzw::new();
