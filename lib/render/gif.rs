@@ -127,29 +127,44 @@ impl Quantiser {
 }
 
 /// GIF's LZW compression (variable-width codes, least significant bit first), written here
-/// because the frames are mostly long runs of the transparent index and a direct child table
-/// (no hashing) compresses them several times faster than a general encoder. Returns the
+/// because the frames are mostly long runs of the transparent index, which we can skip over
+/// (see `runs` below), and a small open-addressing table that stays in cache. Returns the
 /// minimum code size byte followed by the codes, as [`gif::Encoder::write_lzw_pre_encoded_frame`]
-/// expects. `children` is reused between frames; entries set here are cleared before returning.
+/// expects. The table is reused between frames.
 struct Lzw {
-    /// `children[code * 256 + byte]`: the code for `code`'s string followed by `byte` (0 = none;
-    /// no code below the first free one is ever a child).
-    children: Vec<u16>,
-    used: Vec<u32>,
+    /// (prefix code << 8 | byte) of each slot, `EMPTY` when free.
+    keys: Vec<u32>,
+    /// The code of the string in the same slot.
+    codes: Vec<u16>,
 }
+
+const EMPTY: u32 = u32::MAX;
+/// Slots: twice the 4096 codes, so probes stay short.
+const SLOT_BITS: u32 = 13;
 
 const MIN_CODE_SIZE: u8 = 8;
 
 impl Lzw {
     fn new() -> Lzw {
-        Lzw { children: vec![0; 4096 * 256], used: Vec::with_capacity(4096) }
+        Lzw { keys: vec![EMPTY; 1 << SLOT_BITS], codes: vec![0; 1 << SLOT_BITS] }
     }
 
     fn reset(&mut self) {
-        for &slot in &self.used {
-            self.children[slot as usize] = 0;
+        self.keys.fill(EMPTY);
+    }
+
+    /// The slot holding `key`, or the free slot where it would go.
+    #[inline]
+    fn slot(&self, key: u32) -> usize {
+        let mask = (1usize << SLOT_BITS) - 1;
+        let mut s = (key.wrapping_mul(0x9E37_79B1) >> (32 - SLOT_BITS)) as usize;
+        loop {
+            let k = self.keys[s];
+            if k == key || k == EMPTY {
+                return s;
+            }
+            s = (s + 1) & mask;
         }
-        self.used.clear();
     }
 
     fn encode(&mut self, data: &[u8]) -> Vec<u8> {
@@ -187,18 +202,18 @@ impl Lzw {
                     i += ahead;
                     continue;
                 }
-                let slot = (prefix as usize) << 8 | b as usize;
-                let child = self.children[slot];
-                if child != 0 {
-                    prefix = child as u32;
+                let key = prefix << 8 | b as u32;
+                let slot = self.slot(key);
+                if self.keys[slot] == key {
+                    prefix = self.codes[slot] as u32;
                     prefix_run = 0;
                     i += 1;
                     continue;
                 }
                 emit(prefix, width, &mut out);
                 if next < 4096 {
-                    self.children[slot] = next as u16;
-                    self.used.push(slot as u32);
+                    self.keys[slot] = key;
+                    self.codes[slot] = next as u16;
                     if prefix_run > 0 && b == TRANSPARENT {
                         runs.push(next as u16);
                     }
