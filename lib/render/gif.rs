@@ -355,6 +355,23 @@ pub fn render_gif(tracks: &[Track], legend: &Legend, opts: &GifOptions) -> Resul
     encoder.into_inner().map_err(fail)
 }
 
+/// Index of the first byte where `a` and `b` differ (they do somewhere), 8 bytes at a time.
+fn first_difference(a: &[u8], b: &[u8]) -> usize {
+    let words = a.len() / 8;
+    let word = |s: &[u8], i: usize| u64::from_ne_bytes(s[i * 8..i * 8 + 8].try_into().unwrap_or([0; 8]));
+    let start = (0..words).find(|&i| word(a, i) != word(b, i)).map_or(words * 8, |i| i * 8);
+    a[start..].iter().zip(&b[start..]).position(|(p, q)| p != q).map_or(0, |d| start + d)
+}
+
+/// Index of the last byte where `a` and `b` differ (they do somewhere).
+fn last_difference(a: &[u8], b: &[u8]) -> usize {
+    let n = a.len();
+    let words = n / 8;
+    let word = |s: &[u8], i: usize| u64::from_ne_bytes(s[n - i * 8 - 8..n - i * 8].try_into().unwrap_or([0; 8]));
+    let end = (0..words).find(|&i| word(a, i) != word(b, i)).map_or(n - words * 8, |i| n - i * 8);
+    a[..end].iter().zip(&b[..end]).rposition(|(p, q)| p != q).unwrap_or(0)
+}
+
 /// The rectangle where `cur` differs from `prev`, as palette indices with unchanged pixels
 /// transparent; `None` when nothing changed.
 fn changed_frame(cur: &Canvas, prev: &Canvas, quantiser: &mut Quantiser, delay: u16) -> Option<gif::Frame<'static>> {
@@ -364,8 +381,8 @@ fn changed_frame(cur: &Canvas, prev: &Canvas, quantiser: &mut Quantiser, delay: 
         if a == b {
             continue;
         }
-        let first = a.iter().zip(b).position(|(p, q)| p != q).unwrap_or(0) / 3;
-        let last = a.iter().zip(b).rposition(|(p, q)| p != q).unwrap_or(0) / 3;
+        let first = first_difference(a, b) / 3;
+        let last = last_difference(a, b) / 3;
         x0 = x0.min(first);
         x1 = x1.max(last + 1);
         y0 = y0.min(y);
@@ -378,10 +395,17 @@ fn changed_frame(cur: &Canvas, prev: &Canvas, quantiser: &mut Quantiser, delay: 
     for y in y0..y1 {
         let a = &cur.pixels[y * stride + x0 * 3..y * stride + x1 * 3];
         let b = &prev.pixels[y * stride + x0 * 3..y * stride + x1 * 3];
-        for (p, q) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
-            // Fixed-size arrays compare inline (slices would call memcmp per pixel).
-            let (p3, q3): ([u8; 3], [u8; 3]) = (p.try_into().unwrap_or_default(), q.try_into().unwrap_or_default());
-            buffer.push(if p3 == q3 { TRANSPARENT } else { quantiser.index(&p3) });
+        let mut k = 0;
+        while k + 3 <= a.len() {
+            // Skip unchanged stretches 8 bytes at a time; most of the rectangle did not move.
+            if k + 24 <= a.len() && a[k..k + 24] == b[k..k + 24] {
+                buffer.extend_from_slice(&[TRANSPARENT; 8]);
+                k += 24;
+                continue;
+            }
+            let same = a[k] == b[k] && a[k + 1] == b[k + 1] && a[k + 2] == b[k + 2];
+            buffer.push(if same { TRANSPARENT } else { quantiser.index(&a[k..k + 3]) });
+            k += 3;
         }
     }
     Some(gif::Frame {
@@ -507,6 +531,17 @@ mod tests {
             assert!(f.buffer.as_ref() == data.as_slice(), "decoded pixels differ");
         }
         assert!(lzw.encode(&[]).len() >= 2);
+    }
+
+    #[test]
+    fn differences_are_found_at_both_ends() {
+        let a = vec![5u8; 61];
+        for (i, j) in [(0, 0), (3, 40), (17, 60), (60, 60), (8, 9)] {
+            let mut b = a.clone();
+            b[i] = 1;
+            b[j] = 2;
+            assert_eq!((first_difference(&a, &b), last_difference(&a, &b)), (i, j));
+        }
     }
 
     #[test]

@@ -150,6 +150,8 @@ impl Canvas {
             return;
         };
         let len = len2.sqrt();
+        let outer2 = (r + 0.5) * (r + 0.5);
+        let inner2 = if r > 0.5 { (r - 0.5) * (r - 0.5) } else { 0.0 };
         for y in y0..y1 {
             let py = y as f32 + 0.5;
             // Only the pixels of this row within `reach` of the infinite line can be covered:
@@ -166,10 +168,13 @@ impl Canvas {
                 let px = x as f32 + 0.5;
                 let t = (((px - a.0) * dx + (py - a.1) * dy) / len2).clamp(0.0, 1.0);
                 let (ex, ey) = (px - a.0 - t * dx, py - a.1 - t * dy);
-                let cover = r + 0.5 - (ex * ex + ey * ey).sqrt();
-                if cover > 0.0 {
-                    self.blend_pixel(x, y, c, (cover.min(1.0) * 256.0) as u32);
+                let d2 = ex * ex + ey * ey;
+                // Square roots only on the one-pixel edge band.
+                if d2 >= outer2 {
+                    continue;
                 }
+                let alpha = if d2 <= inner2 { 256 } else { ((r + 0.5 - d2.sqrt()).clamp(0.0, 1.0) * 256.0) as u32 };
+                self.blend_pixel(x, y, c, alpha);
             }
         }
     }
