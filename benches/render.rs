@@ -38,6 +38,33 @@ fn repeated(track: &Track, frames: usize) -> Track {
     t
 }
 
+/// Composite GIF frame `k` to a PNG, to look at a GIF with a PNG viewer.
+fn gif_frame_png(gif_bytes: &[u8], k: usize, out: &Path) {
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut d = options.read_info(std::io::Cursor::new(gif_bytes)).unwrap();
+    let (w, h) = (d.width() as usize, d.height() as usize);
+    let mut screen = vec![0u8; w * h * 3];
+    let mut i = 0;
+    while let Some(f) = d.read_next_frame().unwrap() {
+        for y in 0..f.height as usize {
+            for x in 0..f.width as usize {
+                let p = &f.buffer[(y * f.width as usize + x) * 4..][..4];
+                if p[3] != 0 {
+                    let o = ((f.top as usize + y) * w + f.left as usize + x) * 3;
+                    screen[o..o + 3].copy_from_slice(&p[..3]);
+                }
+            }
+        }
+        if i == k {
+            break;
+        }
+        i += 1;
+    }
+    let canvas = menagerie::render::raster::Canvas { width: w as u32, height: h as u32, pixels: screen };
+    std::fs::write(out, canvas.to_png().unwrap()).unwrap();
+}
+
 fn look(root: &Path, dir: &Path) {
     std::fs::create_dir_all(dir).unwrap();
     let mut files: Vec<PathBuf> = common::bvh_files(&root.join("examples/data"));
@@ -62,9 +89,24 @@ fn look(root: &Path, dir: &Path) {
         let fixed = SheetOptions { framing: Framing::Fixed, ..Default::default() };
         std::fs::write(dir.join(format!("{stem}-fixed.png")), render_sheet(std::slice::from_ref(&track), &legend, &fixed).unwrap()).unwrap();
         let short = Track { frames: track.frames.min(240), positions: track.positions[..track.frames.min(240) * track.points()].to_vec(), ..track };
-        std::fs::write(dir.join(format!("{stem}.gif")), render_gif(&[short], &legend, &GifOptions::default()).unwrap()).unwrap();
+        let gif_bytes = render_gif(&[short], &legend, &GifOptions::default()).unwrap();
+        gif_frame_png(&gif_bytes, 20, &dir.join(format!("{stem}-gif20.png")));
+        std::fs::write(dir.join(format!("{stem}.gif")), gif_bytes).unwrap();
         println!("wrote {stem}.png, {stem}-fixed.png, {stem}.gif");
     }
+    // Two motions side by side with labels: tints, label colours, legend.
+    let mut a = load(&root.join("examples/data/biped.bvh"));
+    let mut b = load(&root.join("examples/data/quadruped.bvh"));
+    for t in [&mut a, &mut b] {
+        t.frame_labels = Some((0..t.frames).map(|f| if f % 40 < 20 { Some(0) } else { Some(1) }).collect());
+        t.point_labels = Some((0..t.points()).map(|p| Some(2 + p % 3)).collect());
+    }
+    let labels = Legend { labels: ["walk", "turn", "spine", "left leg", "right leg"].map(String::from).to_vec() };
+    let sheet = render_sheet(&[a.clone(), b.clone()], &labels, &SheetOptions { every: 8, ..Default::default() }).unwrap();
+    std::fs::write(dir.join("pair.png"), sheet).unwrap();
+    let gif_bytes = render_gif(&[a, b], &labels, &GifOptions::default()).unwrap();
+    gif_frame_png(&gif_bytes, 30, &dir.join("pair-gif30.png"));
+    std::fs::write(dir.join("pair.gif"), gif_bytes).unwrap();
 }
 
 /// CPU time of this thread in ns (Linux), so a busy machine does not inflate the numbers the
