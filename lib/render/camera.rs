@@ -144,7 +144,7 @@ pub fn auto_direction(track: &Track) -> Vec3 {
         }
     }
     let ((ax, az), var) = principal(sxx, sxz, szz);
-    if !(var > 0.0) {
+    if var.is_nan() || var <= 0.0 {
         return Vec3::Z;
     }
     let (mut dx, mut dz) = if across { (-az, ax) } else { (ax, az) };

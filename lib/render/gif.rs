@@ -322,7 +322,7 @@ pub fn render_gif(tracks: &[Track], legend: &Legend, opts: &GifOptions) -> Resul
             }
             let oy = HEADER as f32;
             draw_ground(&mut cur, track, cam, f, (x0 + 1, HEADER as i32, pw as i32 - 1, (ph - HEADER) as i32), oy);
-            draw_pose(&mut cur, track, cam, f, x0 as f32, oy, style, &mut scratch);
+            draw_pose(&mut cur, track, cam, f, (x0 as f32, oy), style, &mut scratch);
             cur.text(counter_x[k], (PAD + font::LINE_HEIGHT) as i32, &format!("frame {f}/{}", track.frames - 1), MUTED, 1);
         }
         let delay = (centis(i + 1) - centis(i)).clamp(2, u16::MAX as u64) as u16;

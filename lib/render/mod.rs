@@ -223,7 +223,7 @@ mod tests {
         let (skeleton, motion) = synth::creature("biped", 1).unwrap();
         let t = Track::from_motion("biped.bvh", &skeleton, &motion.first_frames(4));
         let legend = Legend { labels: vec!["a".into()] };
-        assert_eq!(check(&[t.clone()], &legend), Ok(()));
+        assert_eq!(check(std::slice::from_ref(&t), &legend), Ok(()));
         assert!(matches!(check(&[], &legend), Err(RenderError::Empty(_))));
         let mut empty = t.clone();
         empty.frames = 0;

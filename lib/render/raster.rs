@@ -140,7 +140,7 @@ impl Canvas {
         let r = (width * 0.5).max(0.5);
         let (dx, dy) = (b.0 - a.0, b.1 - a.1);
         let len2 = dx * dx + dy * dy;
-        if !(len2 > 1e-6) {
+        if len2.is_nan() || len2 <= 1e-6 {
             self.disc(a, r, c);
             return;
         }

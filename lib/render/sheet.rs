@@ -45,7 +45,7 @@ pub(super) fn frame_tint(track: &Track, f: usize) -> Option<Rgb> {
 
 /// Draw frame `f` of `track` with `cam`, offset by (ox, oy) pixels. `scratch` holds projected
 /// points between calls (no allocation per frame).
-pub(super) fn draw_pose(canvas: &mut Canvas, track: &Track, cam: &Camera, f: usize, ox: f32, oy: f32, style: Style, scratch: &mut Vec<(f32, f32)>) {
+pub(super) fn draw_pose(canvas: &mut Canvas, track: &Track, cam: &Camera, f: usize, (ox, oy): (f32, f32), style: Style, scratch: &mut Vec<(f32, f32)>) {
     scratch.clear();
     scratch.extend(track.frame(f).iter().map(|p| {
         let (x, y) = cam.project(f, *p);
@@ -58,9 +58,9 @@ pub(super) fn draw_pose(canvas: &mut Canvas, track: &Track, cam: &Camera, f: usi
             canvas.line(scratch[q], scratch[p], style.bone, colour);
         }
     }
-    for p in 0..scratch.len() {
+    for (p, &at) in scratch.iter().enumerate() {
         if !track.end_site[p] && !track.feet.contains(&p) {
-            canvas.disc(scratch[p], style.dot, label(p).map_or(JOINT, palette));
+            canvas.disc(at, style.dot, label(p).map_or(JOINT, palette));
         }
     }
     for &p in &track.feet {
@@ -190,7 +190,7 @@ pub fn render_sheet(tracks: &[Track], legend: &Legend, opts: &SheetOptions) -> R
             canvas.outline_rect(x0, y0, cw as i32, ch as i32, FAINT);
             let oy = (y0 + NUMBER_HEIGHT as i32) as f32;
             draw_ground(&mut canvas, track, &cam, f, (x0 + 1, y0 + 1, cw as i32 - 2, ch as i32 - 2), oy);
-            draw_pose(&mut canvas, track, &cam, f, x0 as f32, oy, style, &mut scratch);
+            draw_pose(&mut canvas, track, &cam, f, (x0 as f32, oy), style, &mut scratch);
             canvas.text(x0 + 4, y0 + 3, &f.to_string(), MUTED, 1);
         }
         top += (n_rows as u32 * opts.cell_height + PAD) as i32;
@@ -258,9 +258,9 @@ pub(super) mod tests {
     fn bad_options_and_huge_sheets_are_refused() {
         let t = creature_track("snake", 30);
         let legend = Legend::default();
-        let e = render_sheet(&[t.clone()], &legend, &SheetOptions { columns: 0, ..Default::default() }).unwrap_err();
+        let e = render_sheet(std::slice::from_ref(&t), &legend, &SheetOptions { columns: 0, ..Default::default() }).unwrap_err();
         assert!(matches!(e, RenderError::Invalid(_)));
-        let e = render_sheet(&[t.clone()], &legend, &SheetOptions { columns: 200, max_rows: 1, every: 1, cell_width: 100, ..Default::default() });
+        let e = render_sheet(std::slice::from_ref(&t), &legend, &SheetOptions { columns: 200, max_rows: 1, every: 1, cell_width: 100, ..Default::default() });
         assert!(e.is_ok(), "30 cells fit");
         let mut long = t.clone();
         long.frames = 3000;
