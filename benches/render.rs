@@ -94,6 +94,12 @@ fn look(root: &Path, dir: &Path) {
         std::fs::write(dir.join(format!("{stem}.gif")), gif_bytes).unwrap();
         println!("wrote {stem}.png, {stem}-fixed.png, {stem}.gif");
     }
+    // Other views.
+    let q = load(&root.join("examples/data/quadruped.bvh"));
+    for (name, view) in [("top", View::Top), ("front", View::Front), ("angle", View::Angle { yaw: 30.0, pitch: 25.0 })] {
+        let opts = SheetOptions { view, every: 10, columns: 5, max_rows: 1, ..Default::default() };
+        std::fs::write(dir.join(format!("quadruped-{name}.png")), render_sheet(std::slice::from_ref(&q), &legend, &opts).unwrap()).unwrap();
+    }
     // Two motions side by side with labels: tints, label colours, legend.
     let mut a = load(&root.join("examples/data/biped.bvh"));
     let mut b = load(&root.join("examples/data/quadruped.bvh"));

@@ -1,14 +1,17 @@
 //! Orthographic cameras fitted to a whole track, so any creature fills its frame.
 //!
 //! A camera maps world points to pixels: `x = cx + scale * (p . right - shift[frame])`,
-//! `y = cy - scale * (p . up)` (y up on screen). The scale is one number for the whole track,
+//! `y = cy - scale * (p . up - lift[frame])` (y up on screen). The scale is one number for the whole track,
 //! taken from its extent over all frames and all points (end sites included), so a 20 cm mouse
 //! and a 2 m human both fill the picture and size changes within a track stay visible.
 //!
 //! The ground is the lowest height any point reaches in the track, except that when that
 //! lowest point stays just above 0 (by at most 10% of the track's height: foot joints sit a
 //! little above the floor they stand on) the ground is 0, the floor the data was made on.
-//! Views that see the ground from the side put it at the bottom margin.
+//! Level views (auto, side, front, an angle without pitch) see the ground as a line and stand
+//! it on the bottom margin. The top view and pitched angles draw no ground line (a plane seen
+//! at a slant is not a line), and there `Follow` re-centres vertically too, since travel in
+//! depth moves the body up and down the screen.
 
 use super::{RenderError, Track, View};
 use glam::Vec3;
@@ -47,7 +50,9 @@ pub struct Camera {
     cy: f32,
     /// Per-frame horizontal re-centring (`Follow`); empty for `Fixed`.
     shift: Vec<f32>,
-    /// World ground height; `None` in the top view.
+    /// Per-frame vertical re-centring (`Follow` in views that are not level); else empty.
+    lift: Vec<f32>,
+    /// World ground height; `None` in views that are not level.
     ground: Option<f32>,
 }
 
@@ -198,31 +203,25 @@ impl Camera {
         let (right, up) = view_axes(track, view);
         let n = track.points().max(1);
         let root = root_index(track);
-        let ground = (view != View::Top).then(|| ground_height(track));
+        let level = (up - Vec3::Y).length() < 1e-4;
+        let ground = level.then(|| ground_height(track));
         let follow = framing == Framing::Follow;
-        let shift: Vec<f32> = if follow {
-            (0..track.frames).map(|f| track.positions.get(f * n + root).map_or(0.0, |p| p.dot(right))).collect()
-        } else {
-            Vec::new()
-        };
+        let per_frame = |axis: Vec3| -> Vec<f32> { (0..track.frames).map(|f| track.positions.get(f * n + root).map_or(0.0, |p| p.dot(axis))).collect() };
+        let shift = if follow { per_frame(right) } else { Vec::new() };
+        let lift = if follow && !level { per_frame(up) } else { Vec::new() };
         let (mut xlo, mut xhi, mut ylo, mut yhi) = (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY);
         for (i, p) in track.positions.iter().enumerate() {
             let x = p.dot(right) - shift.get(i / n).copied().unwrap_or(0.0);
-            let y = p.dot(up);
+            let y = p.dot(up) - lift.get(i / n).copied().unwrap_or(0.0);
             xlo = xlo.min(x);
             xhi = xhi.max(x);
             ylo = ylo.min(y);
             yhi = yhi.max(y);
         }
-        // The ground must be visible too; in tilted views, where it is a plane, the ground
-        // under the root stands for it.
+        // The ground must be visible too.
         if let Some(g) = ground {
-            for f in (0..track.frames).step_by((track.frames / 256).max(1)) {
-                let r = track.positions.get(f * n + root).copied().unwrap_or(Vec3::ZERO);
-                let y = Vec3::new(r.x, g, r.z).dot(up);
-                ylo = ylo.min(y);
-                yhi = yhi.max(y);
-            }
+            ylo = ylo.min(g);
+            yhi = yhi.max(g);
         }
         if !(xlo <= xhi && ylo <= yhi) {
             (xlo, xhi, ylo, yhi) = (-1.0, 1.0, -1.0, 1.0);
@@ -241,23 +240,24 @@ impl Camera {
         } else {
             margin as f32 + avail_h * 0.5 + scale * (ylo + yhi) * 0.5
         };
-        Camera { right, up, scale, cx, cy, shift, ground }
+        Camera { right, up, scale, cx, cy, shift, lift, ground }
     }
 
     /// Pixel coordinates of world point `p` in frame `frame`.
     #[inline]
     pub fn project(&self, frame: usize, p: Vec3) -> (f32, f32) {
         let s = self.shift.get(frame).copied().unwrap_or(0.0);
-        (self.cx + self.scale * (p.dot(self.right) - s), self.cy - self.scale * p.dot(self.up))
+        let l = self.lift.get(frame).copied().unwrap_or(0.0);
+        (self.cx + self.scale * (p.dot(self.right) - s), self.cy - self.scale * (p.dot(self.up) - l))
     }
 
-    /// Screen y of the ground line in `frame` (under `root`, the root's position then), or
-    /// `None` in the top view.
+    /// Screen y of the ground line in `frame` (`root` is the root's position then; level
+    /// views give the same line in every frame), or `None` in views that are not level.
     pub fn ground_line(&self, frame: usize, root: Vec3) -> Option<f32> {
         self.ground.map(|g| self.project(frame, Vec3::new(root.x, g, root.z)).1)
     }
 
-    /// World ground height used by this camera (`None` in the top view).
+    /// World ground height used by this camera (`None` in views that are not level).
     pub fn ground(&self) -> Option<f32> {
         self.ground
     }
@@ -342,10 +342,17 @@ mod tests {
         let (r, u) = view_axes(&t, View::Angle { yaw: 90.0, pitch: 30.0 });
         assert!((r - Vec3::X).length() < 1e-5 && u.y > 0.8 && u.z < 0.0, "{r} {u}");
         assert!(check_view(View::Angle { yaw: f32::NAN, pitch: 0.0 }).is_err());
-        // Top view: no ground, centred.
+        // Top view: no ground, centred; Follow re-centres on the root in both directions.
         let cam = Camera::fit(&t, View::Top, Framing::Fixed, 100, 100, 5);
         assert!(cam.ground().is_none());
         all_inside(&t, &cam, 100, 100, 5);
+        let walk = walker(1.0, Vec3::Z, 10.0);
+        let cam = Camera::fit(&walk, View::Top, Framing::Follow, 100, 100, 5);
+        all_inside(&walk, &cam, 100, 100, 5);
+        let (a, b) = (cam.project(0, walk.frame(0)[0]), cam.project(19, walk.frame(19)[0]));
+        assert!((a.0 - b.0).abs() < 1e-3 && (a.1 - b.1).abs() < 1e-3, "{a:?} {b:?}");
+        assert!(Camera::fit(&walk, View::Angle { yaw: 0.0, pitch: 30.0 }, Framing::Follow, 100, 100, 5).ground().is_none());
+        assert!(Camera::fit(&walk, View::Angle { yaw: 40.0, pitch: 0.0 }, Framing::Follow, 100, 100, 5).ground().is_some());
     }
 
     #[test]
