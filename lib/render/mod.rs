@@ -112,8 +112,8 @@ pub enum View {
     Auto,
     /// From -x looking along +x: +z is to the right.
     Side,
-    /// From +z looking along -z: +x is to the left (the creature faces the viewer when it
-    /// faces +z, AnyTop's canonical facing).
+    /// From +z looking along -z: +x is to the right (the creature faces the viewer when it
+    /// faces +z, AnyTop's canonical facing; its left side is on the viewer's right).
     Front,
     /// From above, +z down the screen.
     Top,
@@ -154,4 +154,88 @@ pub enum RenderError {
     /// Options that contradict each other or the input (a label index outside the legend...).
     #[error("{0}")]
     Invalid(String),
+}
+
+/// Check tracks before drawing: something to draw, consistent lengths, finite positions and
+/// label indices inside `legend`. Every renderer calls this first, so no picture is half drawn.
+pub fn check(tracks: &[Track], legend: &Legend) -> Result<(), RenderError> {
+    if tracks.is_empty() {
+        return Err(RenderError::Empty("nothing to draw: no motion was given".into()));
+    }
+    for t in tracks {
+        let title = &t.title;
+        let n = t.points();
+        if t.frames == 0 {
+            return Err(RenderError::Empty(format!("{title}: the motion has no frames to draw")));
+        }
+        if n == 0 {
+            return Err(RenderError::Empty(format!("{title}: the skeleton has no joints to draw")));
+        }
+        if t.names.len() != n || t.end_site.len() != n || t.positions.len() != t.frames * n {
+            return Err(RenderError::Invalid(format!(
+                "{title}: inconsistent track: {n} parents, {} names, {} end-site flags, {} positions for {} frames (expected {})",
+                t.names.len(),
+                t.end_site.len(),
+                t.positions.len(),
+                t.frames,
+                t.frames * n
+            )));
+        }
+        if let Some((p, parent)) = t.parents.iter().enumerate().find_map(|(p, q)| q.filter(|&q| q >= n || q == p).map(|q| (p, q))) {
+            return Err(RenderError::Invalid(format!("{title}: point '{}' has parent {parent}, expected another point below {n}", t.names[p])));
+        }
+        if let Some(&foot) = t.feet.iter().find(|&&f| f >= n) {
+            return Err(RenderError::Invalid(format!("{title}: foot {foot} is not a point (there are {n})")));
+        }
+        if !(t.fps.is_finite() && t.fps > 0.0) {
+            return Err(RenderError::Invalid(format!("{title}: frame rate {} is not a positive number", t.fps)));
+        }
+        if let Some(i) = t.positions.iter().position(|p| !p.is_finite()) {
+            let (f, p) = (i / n, i % n);
+            return Err(RenderError::NonFinite(format!(
+                "{title}: frame {f}, point '{}': position {} is not finite",
+                t.names[p], t.positions[i]
+            )));
+        }
+        let labels = legend.labels.len();
+        for (what, list, expected) in [("point", &t.point_labels, n), ("frame", &t.frame_labels, t.frames)] {
+            let Some(list) = list else { continue };
+            if list.len() != expected {
+                return Err(RenderError::Invalid(format!("{title}: {} {what} labels for {expected} {what}s", list.len())));
+            }
+            if let Some((k, l)) = list.iter().enumerate().find_map(|(k, l)| l.filter(|&l| l >= labels).map(|l| (k, l))) {
+                return Err(RenderError::Invalid(format!(
+                    "{title}: {what} {k} has label {l}, but the legend has {labels} labels"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth;
+
+    #[test]
+    fn check_names_what_is_wrong() {
+        let (skeleton, motion) = synth::creature("biped", 1).unwrap();
+        let t = Track::from_motion("biped.bvh", &skeleton, &motion.first_frames(4));
+        let legend = Legend { labels: vec!["a".into()] };
+        assert_eq!(check(std::slice::from_ref(&t), &legend), Ok(()));
+        assert!(matches!(check(&[], &legend), Err(RenderError::Empty(_))));
+        let mut empty = t.clone();
+        empty.frames = 0;
+        empty.positions.clear();
+        assert!(matches!(check(&[empty], &legend), Err(RenderError::Empty(m)) if m.contains("biped.bvh")));
+        let mut bad = t.clone();
+        let n = bad.points();
+        bad.positions[2 * n + 3] = Vec3::new(f32::NAN, 0.0, 0.0);
+        let e = check(&[bad], &legend).unwrap_err();
+        assert!(matches!(&e, RenderError::NonFinite(m) if m.contains("frame 2") && m.contains(&t.names[3]) && m.contains("biped.bvh")), "{e}");
+        let mut labelled = t.clone();
+        labelled.frame_labels = Some(vec![Some(0), None, Some(1), None]);
+        assert!(matches!(check(&[labelled], &legend), Err(RenderError::Invalid(m)) if m.contains("frame 2 has label 1")));
+    }
 }
