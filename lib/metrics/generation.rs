@@ -372,8 +372,11 @@ pub fn generation_metrics(
     opts: &GenerationOptions,
 ) -> Result<GenerationReport, MetricError> {
     let w = opts.window;
-    if w == 0 || opts.min_segment == 0 {
-        return Err(MetricError::Mismatch("generation metrics: window and min_segment must be at least 1 frame".into()));
+    if w == 0 || opts.min_segment == 0 || opts.reps == 0 || opts.gt_pairs == 0 {
+        return Err(MetricError::Mismatch(format!(
+            "generation metrics: window ({w}), min_segment ({}), reps ({}) and gt_pairs ({}) must all be at least 1",
+            opts.min_segment, opts.reps, opts.gt_pairs
+        )));
     }
     if !opts.threshold.is_finite() {
         return Err(MetricError::NonFinite(format!("generation metrics: coverage threshold is {}", opts.threshold)));
@@ -477,14 +480,38 @@ pub fn generation_metrics(
         })
         .collect();
 
+    // Window sums shared by local diversity and coverage: sums[i][k * gt_starts_all + g] =
+    // Σ_{t<w} cost_i[k + t][g + t] for every window start k of sample i (0..=L − w) and g of
+    // the GT concatenation (0..=T − w), summed in t order as GANimator's kernel does.
+    let gt_starts_all = gt_frames - w + 1;
+    let sums: Vec<Vec<f64>> = generated
+        .par_iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let mut out = vec![0.0; (c.frames - w + 1) * gt_starts_all];
+            out.par_chunks_mut(gt_starts_all).enumerate().for_each(|(k, acc)| {
+                for t in 0..w {
+                    let at = (k + t) * gt_frames + t;
+                    for (a, v) in acc.iter_mut().zip(&cost[i][at..at + gt_starts_all]) {
+                        *a += v;
+                    }
+                }
+            });
+            out
+        })
+        .collect();
+
     // Per sample: local diversity, global diversity (best GT clip), intra diversity.
     let per_sample: Vec<Result<(f64, f64), MetricError>> = generated
         .par_iter()
         .enumerate()
         .map(|(i, c)| {
             let m = &cost[i];
-            let windows = window_minima(m, gt_frames, 0, gt_frames, c.frames - w, w);
-            let local = windows.iter().sum::<f64>() / windows.len() as f64 / w as f64;
+            // Starts 0..L − w (the reference leaves the last one out).
+            let windows = sums[i].chunks_exact(gt_starts_all).take(c.frames - w);
+            let local = windows.map(|row| row.iter().copied().fold(f64::INFINITY, f64::min)).sum::<f64>()
+                / (c.frames - w) as f64
+                / w as f64;
             let mut best = f64::INFINITY;
             for (k, g) in kept.iter().enumerate() {
                 best = best.min(tiling_cost(m, gt_frames, c.frames, gt_starts[k], g.frames, opts.min_segment));
@@ -523,45 +550,55 @@ pub fn generation_metrics(
     let gt_intra_stats = MeanStd::of(&gt_intra);
     let diff: Vec<f64> = intra.iter().map(|v| (v - gt_intra_stats.mean).abs()).collect();
 
-    // Coverage: GT windows against the concatenated subset, per repetition. The nearest
-    // window of every GT start g is found by running over target starts k and, for each,
-    // summing rows k..k+w of the cost (contiguous in g); a minimum does not depend on the
-    // order it is taken in, so chunks of k can run in parallel.
-    let gt_starts_all = gt_frames - w + 1;
+    // Coverage: GT windows against the concatenated subset, per repetition. A target window
+    // lies inside one sample (its sums are above; their minimum over the sample's starts is
+    // taken once) or straddles two consecutive samples of the subset (summed here). A minimum
+    // does not depend on the order it is taken in.
+    let sample_minima: Vec<Vec<f64>> = sums
+        .par_iter()
+        .map(|s| {
+            let mut least = vec![f64::INFINITY; gt_starts_all];
+            for row in s.chunks_exact(gt_starts_all) {
+                for (b, v) in least.iter_mut().zip(row) {
+                    *b = b.min(*v);
+                }
+            }
+            least
+        })
+        .collect();
     let coverages: Vec<f64> = subsets
         .iter()
         .map(|subset| {
-            let rows: Vec<&[f64]> = subset
-                .iter()
-                .flat_map(|&s| cost[s].chunks_exact(gt_frames))
+            let mut best = vec![f64::INFINITY; gt_starts_all];
+            for &s in subset {
+                for (b, v) in best.iter_mut().zip(&sample_minima[s]) {
+                    *b = b.min(*v);
+                }
+            }
+            let straddling: Vec<Vec<f64>> = subset
+                .windows(2)
+                .flat_map(|pair| (1..w).map(move |j| (pair[0], pair[1], j)))
+                .collect::<Vec<_>>()
+                .par_iter()
+                .map(|&(first, second, j)| {
+                    // The last j frames of `first`, then the first w − j of `second`.
+                    let lead = generated[first].frames - j;
+                    let mut acc = vec![0.0; gt_starts_all];
+                    for t in 0..w {
+                        let at = if t < j { (lead + t) * gt_frames + t } else { (t - j) * gt_frames + t };
+                        let m = if t < j { &cost[first] } else { &cost[second] };
+                        for (a, v) in acc.iter_mut().zip(&m[at..at + gt_starts_all]) {
+                            *a += v;
+                        }
+                    }
+                    acc
+                })
                 .collect();
-            let target_starts = rows.len() - w + 1;
-            let best = (0..target_starts)
-                .into_par_iter()
-                .fold(
-                    || vec![f64::INFINITY; gt_starts_all],
-                    |mut best, k| {
-                        let mut acc = vec![0.0; gt_starts_all];
-                        for t in 0..w {
-                            for (a, v) in acc.iter_mut().zip(&rows[k + t][t..t + gt_starts_all]) {
-                                *a += v;
-                            }
-                        }
-                        for (b, a) in best.iter_mut().zip(&acc) {
-                            *b = b.min(*a);
-                        }
-                        best
-                    },
-                )
-                .reduce(
-                    || vec![f64::INFINITY; gt_starts_all],
-                    |mut x, y| {
-                        for (a, b) in x.iter_mut().zip(&y) {
-                            *a = a.min(*b);
-                        }
-                        x
-                    },
-                );
+            for acc in &straddling {
+                for (b, v) in best.iter_mut().zip(acc) {
+                    *b = b.min(*v);
+                }
+            }
             let mut covered = 0usize;
             let mut total = 0usize;
             for (k, g) in kept.iter().enumerate() {
@@ -588,30 +625,6 @@ pub fn generation_metrics(
         coverage_subset: subset,
         warnings,
     })
-}
-
-/// For a row-major cost matrix `m` (`cols` per row) whose source rows are windows' frames:
-/// for each start `i` in `0..starts`, the least sum over `t < w` of `m[i + t][c0 + k + t]`
-/// over target offsets `k` with the whole diagonal inside columns `c0..c0 + width`
-/// (GANimator's `group_cost[i, i + w].min()`; sums run in `t` order as the reference's).
-fn window_minima(m: &[f64], cols: usize, c0: usize, width: usize, starts: usize, w: usize) -> Vec<f64> {
-    if width < w {
-        return vec![f64::INFINITY; starts];
-    }
-    let offsets = width - w + 1;
-    (0..starts)
-        .into_par_iter()
-        .map(|i| {
-            let mut acc = vec![0.0; offsets];
-            for t in 0..w {
-                let row = &m[(i + t) * cols + c0 + t..(i + t) * cols + c0 + t + offsets];
-                for (a, v) in acc.iter_mut().zip(row) {
-                    *a += v;
-                }
-            }
-            acc.iter().copied().fold(f64::INFINITY, f64::min)
-        })
-        .collect()
 }
 
 /// GANimator's `nn_dp`: the least total cost of cutting a `len`-frame source (rows of `m`)
@@ -657,12 +670,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn window_minima_and_tiling_follow_their_definitions() {
+    fn tiling_follows_its_definition() {
         // Source 4 frames × target 5 frames; cost = |a − b| (a diagonal match at offset 1).
         let m: Vec<f64> = (0..4).flat_map(|a| (0..5).map(move |b| (a as f64 - b as f64 + 1.0).abs())).collect();
-        assert_eq!(window_minima(&m, 5, 0, 5, 2, 3), vec![0.0, 0.0]);
-        // Restricted to columns 2..5: the best diagonal for start 0 is offset 0 → cost 3·1.
-        assert_eq!(window_minima(&m, 5, 2, 3, 1, 3), vec![3.0]);
         assert_eq!(tiling_cost(&m, 5, 4, 0, 5, 2), 0.0);
         // Pieces longer than the target cannot exist.
         assert!(tiling_cost(&m, 5, 4, 0, 1, 2).is_infinite());
@@ -755,6 +765,23 @@ mod tests {
     }
 
     #[test]
+    fn coverage_counts_windows_straddling_consecutive_samples() {
+        // GT frames 0..100; samples 0..40 and 40..80. Drawn in that order, the concatenation is
+        // frames 0..80 and covers GT starts 0..=65 (66 windows); drawn the other way round,
+        // starts 26..=39 are lost at the seam (52 windows). Of the 85 GT starts.
+        let gt = [slide(0, 100, 0.5, 0.0)];
+        let gen = [slide(0, 40, 0.5, 0.0), slide(40, 40, 0.5, 0.0)];
+        let mut mixed = false;
+        for seed in 0..8 {
+            let r = generation_metrics(&gen, &gt, &GenerationOptions { seed, ..Default::default() }).unwrap();
+            let in_order = (0..=10).find(|&a| near(r.coverage.mean, (a * 66 + (10 - a) * 52) as f64 / 850.0 * 100.0));
+            let a = in_order.unwrap_or_else(|| panic!("coverage {} is no mix of 66/85 and 52/85", r.coverage.mean));
+            mixed |= a > 0 && a < 10;
+        }
+        assert!(mixed, "both orders should be drawn at some seed");
+    }
+
+    #[test]
     fn same_seed_same_report_at_any_thread_count() {
         let gen: Vec<PointClip> = (0..5).map(|i| wave(40, i as f64, 0.25)).collect();
         let gt: Vec<PointClip> = (0..3).map(|i| wave(70, 0.5 + i as f64, 0.2)).collect();
@@ -782,6 +809,8 @@ mod tests {
             Err(MetricError::TooLittle(m)) => assert!(m.contains("sample 0"), "{m}"),
             other => panic!("{other:?}"),
         }
+        let zero_reps = GenerationOptions { reps: 0, ..opts.clone() };
+        assert!(matches!(generation_metrics(&gt, &gt, &zero_reps), Err(MetricError::Mismatch(_))));
         let two_points = slide(0, 60, 0.1, 0.0);
         assert!(matches!(generation_metrics(&[two_points], &gt, &opts), Err(MetricError::Mismatch(_))));
         assert!(matches!(PointClip::new(2, 3, vec![0.0, 1.0, 2.0, 3.0, f64::NAN, 5.0]), Err(MetricError::NonFinite(m)) if m.contains("frame 1 value 1")));
