@@ -4,7 +4,8 @@
 //! skeleton's GT clips (reference/anytop.md §6). Rows:
 //!
 //! * `generation`: `generation_metrics` on 20 samples × 120 frames against 10 GT clips of 100
-//!   frames, built from the project's own creatures (`synth`), for several joint counts;
+//!   frames, built from the project's own creatures (`synth`), for several joint counts, on
+//!   all cores and on one thread;
 //! * `fid`: `fid` on 200 vs 200 random vectors of 72 and 300 dimensions.
 //!
 //! When `../shared/data` is present, a sanity block also scores a few real clips of one
@@ -55,7 +56,11 @@ fn point_clip(skeleton: &Skeleton, motion: &Motion) -> PointClip {
 
 fn main() {
     println!("generation metrics: 20 samples x 120 frames vs 10 GT clips x 100 frames; median of {RUNS} runs, {} threads", rayon::current_num_threads());
-    println!("{:<12} {:>7} {:>12} {:>10} {:>10} {:>10}", "creature", "joints", "median ms", "coverage", "local", "global");
+    println!(
+        "{:<12} {:>7} {:>12} {:>14} {:>10} {:>10} {:>10}",
+        "creature", "joints", "median ms", "1-thread ms", "coverage", "local", "global"
+    );
+    let single = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     for name in ["biped", "quadruped", "spider", "centipede", "dragon"] {
         let Some((skeleton, motion)) = creature(name, 1) else { continue };
         let base = point_clip(&skeleton, &motion);
@@ -75,11 +80,17 @@ fn main() {
         let times = time_runs(|| {
             black_box(generation_metrics(&generated, &gt, &opts).unwrap());
         });
+        let one = single.install(|| {
+            time_runs(|| {
+                black_box(generation_metrics(&generated, &gt, &opts).unwrap());
+            })
+        });
         println!(
-            "{:<12} {:>7} {:>12.1} {:>10.1} {:>10.4} {:>10.4}",
+            "{:<12} {:>7} {:>12.1} {:>14.1} {:>10.1} {:>10.4} {:>10.4}",
             name,
             skeleton.len(),
             ms(median(&times)),
+            ms(median(&one)),
             report.coverage.mean,
             report.local_diversity.mean,
             report.global_diversity.mean
