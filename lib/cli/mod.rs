@@ -75,7 +75,6 @@ pub fn all_commands() -> Vec<clap::Command> {
         mo_encode::Args::command(),
         mo_retarget::Args::command(),
         mo_metrics::Args::command(),
-        // mo-render and mo-metrics join here (and get man pages, completions and a tested
-        // EXAMPLES block) when they stop being stubs.
+        mo_render::Args::command(),
     ]
 }
