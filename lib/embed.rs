@@ -284,7 +284,7 @@ impl NameTable {
         }
         let chars: Vec<(usize, char)> = w.char_indices().collect();
         let n = chars.len();
-        if n < 4 || n > 64 {
+        if !(4..=64).contains(&n) {
             return None;
         }
         let byte = |k: usize| if k == n { w.len() } else { chars[k].0 };
