@@ -27,6 +27,13 @@
 //!    same name always gets the same vector.
 //!
 //! Every output is a finite unit vector of `dims()` floats; same name -> same bytes.
+//!
+//! `MiniLm` (submodule `minilm`) runs the model itself from the PyPI package's files, for
+//! exact vectors of any name when those files are at hand; it also checks the table.
+
+pub mod minilm;
+
+pub use minilm::{MiniLm, MiniLmError};
 
 use crate::skeleton::names::normalise;
 use crate::skeleton::Skeleton;

