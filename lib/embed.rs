@@ -14,14 +14,14 @@
 //! 2. otherwise the name is composed: the words after the side word are covered greedily by the
 //!    longest word runs the table has ("Left Wing Upper Arm Tip" -> "wing" + "upper arm" +
 //!    "tip"), each run weighted by its word count (the generator measured plain averaging to be
-//!    the closest to MiniLM's own embedding of the joined words: mean cosine 0.86, versus 0.83
+//!    the closest to MiniLM's own embedding of the joined words: mean cosine 0.84, versus 0.80
 //!    with the last word weighted 1.5x); an unknown word tries a singular form and a split
 //!    into known words (`lowerneck` -> lower + neck), else it is skipped; a side is then added
 //!    as a learned offset, `unit(base + offset[side])`, where `offset[side]` is the mean of
 //!    `embed("side X") - embed("X")` over the table. Why an offset and not the side word's own
-//!    vector: on held-out pairs the offset lands at cosine 0.961 from MiniLM's true embedding
-//!    of the sided name (0.920 for the opposite side, so sides stay apart), while the best
-//!    weighted side *word* (weight 0.3) only reaches 0.881 (0.862 opposite);
+//!    vector: on held-out pairs the offset lands at cosine 0.964 from MiniLM's true embedding
+//!    of the sided name (0.930 for the opposite side, so sides stay apart), while the best
+//!    weighted side *word* (weight 0.3) only reaches 0.893 (0.876 opposite);
 //! 3. a name none of whose words is known gets a deterministic pseudo-random unit vector seeded
 //!    by an FNV-1a hash of the normalised name, so distinct unknown names stay distinct and the
 //!    same name always gets the same vector.

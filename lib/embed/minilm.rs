@@ -249,7 +249,7 @@ impl MiniLm {
             for i in 0..n {
                 let qi = &q[i * h + o..][..d];
                 for (j, pj) in p.iter_mut().enumerate() {
-                    *pj = qi.iter().zip(&k[j * h + o..][..d]).map(|(a, b)| a * b).sum::<f32>() * scale;
+                    *pj = dot(qi, &k[j * h + o..][..d]) * scale;
                 }
                 let m = p.iter().fold(f32::NEG_INFINITY, |m, &v| m.max(v));
                 let mut sum = 0f32;
@@ -285,11 +285,25 @@ impl Linear {
         let mut y = Vec::with_capacity(n * self.out);
         for row in x.chunks_exact(self.inp).take(n) {
             for (o, w) in self.w.chunks_exact(self.inp).enumerate() {
-                y.push(self.b[o] + row.iter().zip(w).map(|(a, b)| a * b).sum::<f32>());
+                y.push(self.b[o] + dot(row, w));
             }
         }
         y
     }
+}
+
+/// Dot product with eight independent partial sums: a single running sum is bound by the add
+/// latency and cannot be vectorised (float addition is not associative); eight lanes are.
+fn dot(a: &[f32], b: &[f32]) -> f32 {
+    let mut acc = [0f32; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f32 = ca.remainder().iter().zip(cb.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in ca.zip(cb) {
+        for l in 0..8 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    acc.iter().sum::<f32>() + tail
 }
 
 /// BERT's exact GELU, `x/2 (1 + erf(x/sqrt 2))`.
