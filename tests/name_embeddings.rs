@@ -246,4 +246,18 @@ fn minilm_forward_matches_the_table() {
 fn minilm_missing_files_are_errors() {
     let dir = std::env::temp_dir().join("menagerie-no-minilm-here");
     assert!(menagerie::embed::MiniLm::load(&dir).is_err());
+    // Files present but wrong: a config without the fields, then a model file that is not safetensors.
+    let dir = std::env::temp_dir().join(format!("menagerie-bad-minilm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("config.json"), "{}").unwrap();
+    let e = menagerie::embed::MiniLm::load(&dir).err().expect("empty config rejected");
+    assert!(e.to_string().contains("config.json"), "{e}");
+    let cfg = r#"{"hidden_size":8,"num_attention_heads":2,"num_hidden_layers":1,"intermediate_size":16,"layer_norm_eps":1e-12,"max_position_embeddings":16,"vocab_size":4}"#;
+    std::fs::write(dir.join("config.json"), cfg).unwrap();
+    let tok = r###"{"model":{"vocab":{"[UNK]":0,"[CLS]":1,"[SEP]":2,"foot":3},"unk_token":"[UNK]","continuing_subword_prefix":"##","max_input_chars_per_word":100}}"###;
+    std::fs::write(dir.join("tokenizer.json"), tok).unwrap();
+    std::fs::write(dir.join("model.safetensors"), [255u8; 12]).unwrap();
+    let e = menagerie::embed::MiniLm::load(&dir).err().expect("garbage weights rejected");
+    assert!(e.to_string().contains("model.safetensors"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

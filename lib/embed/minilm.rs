@@ -99,6 +99,9 @@ impl MiniLm {
         };
         let bad = |name: &str, what: String| MiniLmError::Format { path: dir.join(name), what };
         let cfg: Config = serde_json::from_slice(&read("config.json")?).map_err(|e| bad("config.json", e.to_string()))?;
+        if cfg.max_position_embeddings < 2 || cfg.vocab_size == 0 || cfg.hidden_size == 0 {
+            return Err(bad("config.json", "hidden_size, vocab_size must be > 0 and max_position_embeddings >= 2".into()));
+        }
         if cfg.num_attention_heads == 0 || cfg.hidden_size % cfg.num_attention_heads != 0 {
             return Err(bad("config.json", format!("hidden_size {} not divisible by {} heads", cfg.hidden_size, cfg.num_attention_heads)));
         }
@@ -407,9 +410,9 @@ impl Safetensors {
         if dtype != "F32" || !fits {
             return Err(format!("tensor {name}: {dtype} {got:?} (expected F32 {shape:?})"));
         }
-        let count: usize = got.iter().product();
-        if b - a != 4 * count {
-            return Err(format!("tensor {name}: {} bytes for {count} floats", b - a));
+        let count = got.iter().try_fold(1usize, |p, &g| p.checked_mul(g)).and_then(|c| c.checked_mul(4));
+        if count != Some(b - a) {
+            return Err(format!("tensor {name}: {} bytes for shape {got:?}", b - a));
         }
         let data = &self.bytes[self.data_start + a..self.data_start + b];
         Ok(data.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())
