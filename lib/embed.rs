@@ -93,6 +93,8 @@ pub struct NameTable {
     left: Vec<f32>,
     right: Vec<f32>,
     last_word_weight: f32,
+    /// Most words in one key: longer runs cannot match, so composition never tries them.
+    max_key_words: usize,
 }
 
 impl NameTable {
@@ -164,7 +166,8 @@ impl NameTable {
             }
             rows.extend(v);
         }
-        Ok(NameTable { model: header.model, dims, keys, index, rows, left, right, last_word_weight: header.last_word_weight })
+        let max_key_words = keys.iter().map(|k| k.split(' ').count()).max().unwrap_or(1);
+        Ok(NameTable { model: header.model, dims, keys, index, rows, left, right, last_word_weight: header.last_word_weight, max_key_words })
     }
 
     /// Width of every embedding.
@@ -247,7 +250,7 @@ impl NameTable {
         let add = |acc: &mut Vec<f64>, v: &[f32], w: f64| acc.iter_mut().zip(v).for_each(|(a, &x)| *a += w * x as f64);
         let mut i = 0;
         while i < words.len() {
-            let run = (i + 1..=words.len()).rev().find_map(|j| {
+            let run = (i + 1..=words.len().min(i + self.max_key_words)).rev().find_map(|j| {
                 let s = words[i..j].join(" ");
                 self.lookup(&s).map(|v| (j, s, v))
             });

@@ -94,6 +94,10 @@ fn unknown_names_fall_back_deterministically() {
     assert!(cosine(&a, &b).abs() < 0.3, "distinct unknown names stay apart");
     assert_unit(&t.embed_name(""), "empty name");
     assert_unit(&t.embed_name("L_Zzqx"), "side + unknown");
+    let long = "Toe".repeat(500);
+    for odd in ["L", "R_", "__", ":", "Left", "ÄÖÜ_Fuß", "ǅ", "İstanbul", "足_L", "ﬀoot", "lowerneckneckneckneckneck", long.as_str(), "\u{0}\u{fffd}"] {
+        assert_unit(&t.embed_name(odd), odd);
+    }
     let h = hash_unit_vector("abc", 384);
     assert_eq!(h.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), hash_unit_vector("abc", 384).iter().map(|x| x.to_bits()).collect::<Vec<_>>());
 }
