@@ -16,6 +16,9 @@ _mo__metrics() {
             ",$1")
                 cmd="mo__metrics"
                 ;;
+            mo__metrics,aggregate)
+                cmd="mo__metrics__subcmd__aggregate"
+                ;;
             mo__metrics,generation)
                 cmd="mo__metrics__subcmd__generation"
                 ;;
@@ -30,6 +33,9 @@ _mo__metrics() {
                 ;;
             mo__metrics,transfer)
                 cmd="mo__metrics__subcmd__transfer"
+                ;;
+            mo__metrics__subcmd__help,aggregate)
+                cmd="mo__metrics__subcmd__help__subcmd__aggregate"
                 ;;
             mo__metrics__subcmd__help,generation)
                 cmd="mo__metrics__subcmd__help__subcmd__generation"
@@ -53,8 +59,50 @@ _mo__metrics() {
 
     case "${cmd}" in
         mo__metrics)
-            opts="-o -q -v -h -V --format --skeleton --from --output --seed --quiet --verbose --threads --help --version generation transfer reconstruction physics help"
+            opts="-o -q -v -h -V --format --skeleton --from --output --seed --quiet --verbose --threads --help --version generation transfer reconstruction aggregate physics help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --format)
+                    COMPREPLY=($(compgen -W "json table" -- "${cur}"))
+                    return 0
+                    ;;
+                --skeleton)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --from)
+                    COMPREPLY=($(compgen -W "rotations positions" -- "${cur}"))
+                    return 0
+                    ;;
+                --output)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                -o)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mo__subcmd__metrics__subcmd__aggregate)
+            opts="-o -q -v -h --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
@@ -157,8 +205,22 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__help)
-            opts="generation transfer reconstruction physics help"
+            opts="generation transfer reconstruction aggregate physics help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mo__subcmd__metrics__subcmd__help__subcmd__aggregate)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi

@@ -39,6 +39,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s V -l version -d '
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "generation" -d 'AnyTop\'s generation metrics: generated samples against ground-truth clips of one skeleton'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "transfer" -d 'Motion2Motion\'s transfer metrics: results against their source and the target\'s examples'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "reconstruction" -d 'SATA\'s reconstruction metrics: a result against a reference motion on the same skeleton'
+complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "aggregate" -d 'The paper\'s table row: mean and std over skeletons of per-skeleton generation results'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "physics" -d 'Physical plausibility of any motion: foot skating, ground penetration, floating, jitter'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l gt -d 'Ground-truth clips (files or directories)' -r -F
@@ -87,6 +88,17 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l format -d 'Output format' -r -f -a "json\t''
+table\t''"
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l skeleton -d 'Skeleton of NPY inputs: a skeleton document (skel-info) or a BVH file' -r -F
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l from -d 'AnyTop features: pose from their rotations or (generated clips) their positions by IK' -r -f -a "rotations\t'The features\' 6D rotations: exact for encoded features'
+positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s q -l quiet -d 'Print nothing on stderr but errors'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s v -l verbose -d 'Print more about what is happening on stderr'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l ground -d 'Ground: \'zero\' (y = 0), \'estimate\' (lowest foot height over the clip) or a height' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l contact-height -d 'Contact height threshold, as a fraction of the skeleton\'s size' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l contact-speed -d 'Contact speed threshold, as a fraction of the skeleton\'s size per second' -r
@@ -101,8 +113,9 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l thread
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s h -l help -d 'Print help (see more with \'--help\')'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction physics help" -f -a "generation" -d 'AnyTop\'s generation metrics: generated samples against ground-truth clips of one skeleton'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction physics help" -f -a "transfer" -d 'Motion2Motion\'s transfer metrics: results against their source and the target\'s examples'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction physics help" -f -a "reconstruction" -d 'SATA\'s reconstruction metrics: a result against a reference motion on the same skeleton'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction physics help" -f -a "physics" -d 'Physical plausibility of any motion: foot skating, ground penetration, floating, jitter'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction physics help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "generation" -d 'AnyTop\'s generation metrics: generated samples against ground-truth clips of one skeleton'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "transfer" -d 'Motion2Motion\'s transfer metrics: results against their source and the target\'s examples'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "reconstruction" -d 'SATA\'s reconstruction metrics: a result against a reference motion on the same skeleton'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "aggregate" -d 'The paper\'s table row: mean and std over skeletons of per-skeleton generation results'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "physics" -d 'Physical plausibility of any motion: foot skating, ground penetration, floating, jitter'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'

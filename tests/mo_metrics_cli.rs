@@ -124,3 +124,27 @@ fn bad_input_exits_2() {
     let out = run("mo-metrics", &["generation", "--gt", s(&crab), "--gen", s(&bird)], None);
     check_failure("mo-metrics", "generation across skeletons", &out, "same skeleton");
 }
+
+#[test]
+fn aggregate_is_the_mean_and_std_over_skeletons() {
+    let dir = tempdir("aggregate");
+    let report = |name: &str, coverage: f64| {
+        let metrics = ["coverage", "local_diversity", "global_diversity", "inter_diversity", "intra_diversity", "gt_intra_diversity", "intra_diversity_diff"];
+        let mut r = serde_json::Map::new();
+        for (i, m) in metrics.iter().enumerate() {
+            let mean = if i == 0 { coverage } else { i as f64 };
+            r.insert(m.to_string(), serde_json::json!({"mean": mean, "std": 9.0}));
+        }
+        let path = dir.join(format!("{name}.json"));
+        std::fs::write(&path, serde_json::json!({"metric": "generation", "skeleton": name, "report": r}).to_string()).unwrap();
+        path
+    };
+    let (a, b) = (report("dog", 80.0), report("crab", 100.0));
+    let v = json(&run("mo-metrics", &["aggregate", s(&a), s(&b)], None), "aggregate");
+    assert_eq!(num(&v, "final.coverage.mean"), 90.0);
+    assert_eq!(num(&v, "final.coverage.std"), 10.0, "population std of 80 and 100");
+    assert_eq!(num(&v, "final.inter_diversity.std"), 0.0);
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, r#"{"metric": "physics"}"#).unwrap();
+    check_failure("mo-metrics", "not a generation report", &run("mo-metrics", &["aggregate", s(&bad)], None), "not a report of `mo-metrics generation`");
+}

@@ -149,6 +149,16 @@ pub enum Command {
         #[arg(long, value_name = "H")]
         height: Option<f64>,
     },
+    /// The paper's table row: mean and std over skeletons of per-skeleton generation results.
+    ///
+    /// Reads the JSON reports `mo-metrics generation` printed (one per skeleton) and gives, for
+    /// every metric, the mean and std over skeletons of the per-skeleton means, as AnyTop's
+    /// tables report them.
+    Aggregate {
+        /// Generation reports (JSON files, '-' = stdin).
+        #[arg(value_name = "REPORT", required = true, num_args = 1..)]
+        reports: Vec<PathBuf>,
+    },
     /// Physical plausibility of any motion: foot skating, ground penetration, floating, jitter.
     ///
     /// A foot is in contact when it is within --contact-height x the skeleton's size of the
@@ -214,6 +224,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Command::Transfer { source, result, binding, examples, seconds } => {
             run_transfer(args, source, result, binding.as_deref(), examples, *seconds)?
         }
+        Command::Aggregate { reports } => run_aggregate(reports)?,
         Command::Generation { gt, generated, window, threshold, min_segment } => {
             let opts = GenerationOptions { window: *window, threshold: *threshold, min_segment: *min_segment, seed: args.common.seed, ..GenerationOptions::default() };
             run_generation(args, gt, generated, &opts)?
@@ -458,6 +469,39 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
             ("gt_intra_diversity", "mean joint distance, AnyTop units"),
             ("intra_diversity_diff", "mean joint distance, AnyTop units"),
         ]),
+    }))
+}
+
+/// The metrics a generation report carries, in table order.
+const GENERATION_METRICS: [&str; 7] =
+    ["coverage", "local_diversity", "global_diversity", "inter_diversity", "intra_diversity", "gt_intra_diversity", "intra_diversity_diff"];
+
+fn run_aggregate(paths: &[PathBuf]) -> anyhow::Result<Value> {
+    let mut skeletons = Vec::new();
+    let mut means: Vec<Vec<f64>> = vec![Vec::new(); GENERATION_METRICS.len()];
+    for path in paths {
+        let name = io::display_name(path);
+        let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+        let v: Value = serde_json::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{name}: not JSON: {e}"))?;
+        if v.get("metric").and_then(Value::as_str) != Some("generation") {
+            bail!("{name}: not a report of `mo-metrics generation` (no \"metric\": \"generation\")");
+        }
+        for (k, key) in GENERATION_METRICS.iter().enumerate() {
+            let m = v["report"][key]["mean"].as_f64().with_context(|| format!("{name}: report.{key}.mean is missing or not a number"))?;
+            means[k].push(m);
+        }
+        skeletons.push(v["skeleton"].as_str().unwrap_or(&name).to_string());
+    }
+    let mut fin = Map::new();
+    for (k, key) in GENERATION_METRICS.iter().enumerate() {
+        fin.insert(key.to_string(), serde_json::to_value(generation::MeanStd::of(&means[k]))?);
+    }
+    Ok(json!({
+        "metric": "generation-aggregate",
+        "skeletons": skeletons,
+        "final": fin,
+        "units": units(&[("coverage", "percent of ground-truth windows"), ("local_diversity", "AnyTop units"), ("global_diversity", "AnyTop units"),
+            ("inter_diversity", "AnyTop units"), ("intra_diversity", "AnyTop units"), ("gt_intra_diversity", "AnyTop units"), ("intra_diversity_diff", "AnyTop units")]),
     }))
 }
 

@@ -10,7 +10,7 @@
 //! Motion2Motion scores transfers with the FID of kinetic features; the recipe it inherits
 //! (Bailando's `calc_metrics`, see reference/motion2motion.md §3.7) first normalises both sets
 //! by the **real** set's per-dimension mean and population std. [`FidOptions::normalise`]
-//! does that (default on). Definitions and deviations: `docs/metrics-generation.md`.
+//! does that (default on). Definitions and deviations: `docs/metrics.md`.
 
 use super::linalg::{covariance, eigen_tolerance, matmul, sqrtm_psd, symmetric_eigenvalues, trace};
 use super::MetricError;

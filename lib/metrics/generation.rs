@@ -15,7 +15,7 @@
 //! work; parallel loops only fill per-item slots, and every reduction runs in item order. So
 //! the same input and seed give bit-identical reports at any thread count.
 //!
-//! Definitions, units and deviations from the reference: `docs/metrics-generation.md`.
+//! Definitions, units and deviations from the reference: `docs/metrics.md`.
 
 use super::{Clip, MetricError};
 use crate::repr::anytop::{Facing, HUMANML_MEAN_BONE_LENGTH};

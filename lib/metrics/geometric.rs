@@ -6,7 +6,7 @@
 //!
 //! The reference hard-wires SMPL joint order; we find the 18 SMPL roles the features use by
 //! name and structure on any human-like skeleton ([`human_roles`]). Deviations (also in
-//! `docs/metrics-motion.md`): thresholds come from the clip's own humerus length, shoulder
+//! `docs/metrics.md`): thresholds come from the clip's own humerus length, shoulder
 //! width and hip width (the reference uses SMPL constants in metres), velocities use the clip's
 //! frame rate (the reference uses a fixed 1/120 s), and a degenerate direction makes a relation
 //! false instead of NaN.
@@ -303,7 +303,7 @@ const FEATURES: [Rel; 32] = [
 ];
 
 /// Names of the 32 features, in order: the reference's relation and threshold (for tables and
-/// JSON). `docs/metrics-motion.md` says what each measures.
+/// JSON). `docs/metrics.md` says what each measures.
 pub const FEATURE_NAMES: [&str; 32] = [
     "(1) nmove(neck,rhip,lhip,rwrist; 1.8hl)",
     "(2) nmove(neck,lhip,rhip,lwrist; 1.8hl)",

@@ -3,7 +3,7 @@
 //! vertical kinetic energy (per unit mass) and the mean energy expenditure. FID over these
 //! vectors is Motion2Motion's FID_k.
 //!
-//! Deviations from the reference (also in `docs/metrics-motion.md`): the frame time is the
+//! Deviations from the reference (also in `docs/metrics.md`): the frame time is the
 //! clip's own (`1 / clip.fps`), not a hard-coded 1/60 s; values stay f64 (the reference casts
 //! to f32); clips shorter than 3 frames are refused instead of giving zero energy expenditure.
 

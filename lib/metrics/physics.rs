@@ -1,6 +1,6 @@
 //! Physical plausibility of one motion, without ground truth: foot skating, ground
 //! penetration, floating and jitter, plus the foot contacts the transfer metrics compare.
-//! Definitions, units and deviations: `docs/metrics-motion.md`.
+//! Definitions, units and deviations: `docs/metrics.md`.
 //!
 //! Every threshold is a fraction of the skeleton's size (`Clip::scale`), so a mouse and a
 //! dinosaur are judged alike; every distance is reported in clip units and divided by the

@@ -1,7 +1,7 @@
 //! Motion transfer metrics of Motion2Motion (`reference/papers/motion2motion.txt` §4.2):
 //! frequency alignment, contact consistency, diversity and throughput. The paper gives one
 //! sentence per metric and the reference code computes none of them, so the exact recipes are
-//! ours; `docs/metrics-motion.md` states each choice.
+//! ours; `docs/metrics.md` states each choice.
 
 use super::physics::{self, check_clip, Maybe, Measure, PhysicsOptions};
 use super::{Clip, MetricError};
