@@ -411,7 +411,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__transfer)
-            opts="-o -q -v -h --source --result --binding --examples --seconds --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            opts="-o -q -v -h --source --result --binding --examples --seconds --fid-window --format --skeleton --from --output --seed --quiet --verbose --threads --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -434,6 +434,10 @@ _mo__metrics() {
                     return 0
                     ;;
                 --seconds)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fid-window)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

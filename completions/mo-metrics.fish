@@ -63,6 +63,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l resul
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l binding -d 'Binding source joint -> target joint (ours or the reference\'s mapping JSON) [default: joints with the same (normalised) names]' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l examples -d 'The target\'s example clips, the real set of the FIDs (files or directories)' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l seconds -d 'Seconds the results took to make (for throughput)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l fid-window -d 'Cut examples and results into windows of this many frames for the FIDs (a set of one or two clips has no covariance; the windows make sets). 0 = whole clips' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l format -d 'Output format' -r -f -a "json\t''
 table\t''"
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l skeleton -d 'Skeleton of NPY inputs: a skeleton document (skel-info) or a BVH file' -r -F

@@ -130,6 +130,10 @@ pub enum Command {
         /// Seconds the results took to make (for throughput).
         #[arg(long, value_name = "S")]
         seconds: Option<f64>,
+        /// Cut examples and results into windows of this many frames for the FIDs (a set of
+        /// one or two clips has no covariance; the windows make sets). 0 = whole clips.
+        #[arg(long, value_name = "FRAMES", default_value_t = 0)]
+        fid_window: usize,
     },
     /// SATA's reconstruction metrics: a result against a reference motion on the same skeleton.
     ///
@@ -221,8 +225,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             run_physics(args, inputs, &opts)?
         }
         Command::Reconstruction { reference, result, height } => run_reconstruction(args, reference, result, *height)?,
-        Command::Transfer { source, result, binding, examples, seconds } => {
-            run_transfer(args, source, result, binding.as_deref(), examples, *seconds)?
+        Command::Transfer { source, result, binding, examples, seconds, fid_window } => {
+            run_transfer(args, source, result, binding.as_deref(), examples, *seconds, *fid_window)?
         }
         Command::Aggregate { reports } => run_aggregate(reports)?,
         Command::Generation { gt, generated, window, threshold, min_segment } => {
@@ -332,7 +336,15 @@ fn run_reconstruction(args: &Args, reference: &Path, result: &Path, height: Opti
     }))
 }
 
-fn run_transfer(args: &Args, source: &Path, results: &[PathBuf], binding: Option<&Path>, examples: &[PathBuf], seconds: Option<f64>) -> anyhow::Result<Value> {
+fn run_transfer(
+    args: &Args,
+    source: &Path,
+    results: &[PathBuf],
+    binding: Option<&Path>,
+    examples: &[PathBuf],
+    seconds: Option<f64>,
+    fid_window: usize,
+) -> anyhow::Result<Value> {
     let src = load_one(args, source)?;
     let results = load(args, results)?;
     let target = &results[0];
@@ -387,17 +399,16 @@ fn run_transfer(args: &Args, source: &Path, results: &[PathBuf], binding: Option
             }
         }
         let ex_clips = ex.iter().map(clip_of).collect::<anyhow::Result<Vec<Clip>>>()?;
-        let kin = |cs: &[Clip], ls: &[Loaded]| -> anyhow::Result<Vec<Vec<f64>>> {
-            cs.iter().zip(ls).map(|(c, l)| kinetic::kinetic_features(c).with_context(|| format!("{}: kinetic features", l.name))).collect()
+        let (ex_sets, result_sets) = (windows(&ex_clips, fid_window), windows(&clips, fid_window));
+        let kin = |cs: &[Clip]| -> anyhow::Result<Vec<Vec<f64>>> {
+            cs.iter().map(|c| kinetic::kinetic_features(c).context("kinetic features")).collect()
         };
-        let real = kin(&ex_clips, &ex)?;
-        let generated = kin(&clips, &results)?;
-        m.insert("fid_kinetic".into(), fid_value(&real, &generated)?);
+        m.insert("fid_kinetic".into(), fid_value(&kin(&ex_sets)?, &kin(&result_sets)?)?);
         let fid_g = match geometric::human_roles(&clips[0]) {
             Ok(roles) => {
                 let opts = geometric::GeometricOptions::default();
                 let g = |cs: &[Clip]| -> anyhow::Result<Vec<Vec<f64>>> { cs.iter().map(|c| Ok(geometric::geometric_features(c, &roles, &opts)?)).collect() };
-                fid_value(&g(&ex_clips)?, &g(&clips)?)?
+                fid_value(&g(&ex_sets)?, &g(&result_sets)?)?
             }
             Err(why) => json!({ "not_applicable": format!("no human roles on the target skeleton: {why}") }),
         };
@@ -417,8 +428,35 @@ fn run_transfer(args: &Args, source: &Path, results: &[PathBuf], binding: Option
     Ok(out)
 }
 
+/// Clips cut into consecutive windows of `len` frames (the remainder dropped); `len` 0 keeps
+/// whole clips.
+fn windows(clips: &[Clip], len: usize) -> Vec<Clip> {
+    if len == 0 {
+        return clips.to_vec();
+    }
+    let mut out = Vec::new();
+    for c in clips {
+        for k in 0..c.frames / len {
+            let mut w = c.clone();
+            w.frames = len;
+            w.positions = c.positions[k * len * c.joints..(k + 1) * len * c.joints].to_vec();
+            out.push(w);
+        }
+    }
+    out
+}
+
 /// FID, or why it has no value (too few clips), as JSON.
 fn fid_value(real: &[Vec<f64>], generated: &[Vec<f64>]) -> anyhow::Result<Value> {
+    // One vector has no covariance: the distance would only say the two means differ, and
+    // normalising by the real set's spread is impossible.
+    if real.len() < 2 || generated.len() < 2 {
+        return Ok(json!({ "not_applicable": format!(
+            "FID needs at least 2 real and 2 generated clips, found {} and {}: give more clips or --fid-window FRAMES",
+            real.len(),
+            generated.len()
+        ) }));
+    }
     Ok(match fid(real, generated, &FidOptions::default()) {
         Ok(f) => serde_json::to_value(f)?,
         Err(crate::metrics::MetricError::TooLittle(why)) => json!({ "not_applicable": why }),
