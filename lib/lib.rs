@@ -7,6 +7,7 @@ pub mod augment;
 pub mod binding;
 pub mod bvh;
 pub mod cli;
+pub mod diffusion;
 pub mod document;
 pub mod embed;
 pub mod io;
