@@ -1,6 +1,7 @@
 //! Diffusion for any skeleton (AnyTop §3): the noise schedule and sampler coefficients.
 //! The model itself is in `nn`; training and sampling loops build on both.
 
+pub mod data;
 pub mod schedule;
 
 pub use schedule::{Sampler, Schedule, Step};
