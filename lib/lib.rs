@@ -11,6 +11,7 @@ pub mod document;
 pub mod io;
 pub mod metrics;
 pub mod motion;
+pub mod nn;
 pub mod render;
 pub mod repr;
 pub mod skeleton;
