@@ -13,6 +13,7 @@ pub mod embed;
 pub mod io;
 pub mod metrics;
 pub mod motion;
+pub mod nn;
 pub mod render;
 pub mod repr;
 pub mod retarget;

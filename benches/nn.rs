@@ -1,0 +1,158 @@
+//! Denoiser speed on CPU: `cargo bench --bench nn`.
+//!
+//! 1. Raw candle f32 matmul throughput (n x n), the peak the model FLOP utilisation is measured
+//!    against. Cargo.toml enables gemm's `x86-v4` feature for this.
+//! 2. For the `tiny`, `small` and `paper` presets: forward, and forward + backward (one training
+//!    step without the optimiser), on a batch of 8 random skeletons with 25..60 joints (padded
+//!    to 60) and 40 frames (41 tokens with P_S). GFLOP/s counts the matmul FLOPs of the model
+//!    (backward = 2x forward), so `fwd+bwd GFLOP/s / matmul peak` is the FLOP utilisation.
+//!
+//! Set `NN_BENCH_PRESETS=tiny,small` to skip presets; medians of `RUNS` runs (fewer for slow ones).
+
+mod common;
+use common::{median, ms, time_runs};
+
+use candle_core::{DType, Device, Tensor};
+use candle_nn::VarMap;
+use glam::DVec3;
+use menagerie::nn::{batch_from, seeded_var_builder, BatchItem, Denoiser, DenoiserConfig};
+use menagerie::repr::Features;
+use menagerie::skeleton::{topology, Joint, Skeleton};
+use menagerie::synth::SplitMix64;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+fn matmul_gflops(n: usize) -> f64 {
+    let dev = Device::Cpu;
+    let a = Tensor::ones((n, n), DType::F32, &dev).unwrap();
+    let b = Tensor::ones((n, n), DType::F32, &dev).unwrap();
+    let _ = a.matmul(&b).unwrap();
+    let t = median(&time_runs(|| {
+        black_box(a.matmul(&b).unwrap());
+    }));
+    2.0 * (n as f64).powi(3) / t.as_secs_f64() / 1e9
+}
+
+struct Clip {
+    features: Features,
+    rest: Vec<f32>,
+    relations: Vec<Vec<u8>>,
+    distances: Vec<Vec<u8>>,
+    names: Vec<Vec<f32>>,
+}
+
+/// A random tree of `joints` joints (each joint's parent is an earlier joint) with random features.
+fn clip(joints: usize, frames: usize, name_dim: usize, rng: &mut SplitMix64) -> Clip {
+    let joints_v: Vec<Joint> = (0..joints)
+        .map(|j| Joint {
+            name: format!("j{j}"),
+            parent: if j == 0 { None } else { Some((rng.unit() * j as f64) as usize) },
+            offset: DVec3::ZERO,
+            channels: vec![],
+            end_sites: vec![],
+        })
+        .collect();
+    let skeleton = Skeleton { joints: joints_v, frame_time: 1.0 / 30.0 };
+    let mut features = Features::zeros(frames, joints, 13);
+    features.data.iter_mut().for_each(|v| *v = rng.range(-1.0, 1.0) as f32);
+    Clip {
+        features,
+        rest: (0..joints * 13).map(|_| rng.range(-1.0, 1.0) as f32).collect(),
+        relations: topology::relations(&skeleton),
+        distances: topology::distances(&skeleton, topology::DEFAULT_DMAX),
+        names: (0..joints).map(|_| (0..name_dim).map(|_| rng.range(-0.1, 0.1) as f32).collect()).collect(),
+    }
+}
+
+/// Matmul FLOPs of one forward pass (multiply-adds x 2), for tokens `b x t x j`.
+fn forward_flops(cfg: &DenoiserConfig, b: usize, t: usize, j: usize) -> f64 {
+    let (d, h) = (cfg.width as f64, cfg.heads as f64);
+    let (b, t, j) = (b as f64, t as f64, j as f64);
+    let n = b * t * j;
+    let types = (cfg.dmax + 1 + 6) as f64;
+    let input = 2.0 * n * (cfg.feature_dims as f64 + cfg.name_dim as f64 / t) * d;
+    let linears = 2.0 * n * d * d * 8.0 + 2.0 * n * d * cfg.ff as f64 * 2.0;
+    let skeletal = 2.0 * b * t * j * j * d * 2.0 + 2.0 * n * d * types * 2.0 + 2.0 * b * j * t * h * types * j;
+    let temporal = 2.0 * b * j * t * t * d * 2.0;
+    let output = 2.0 * n * d * cfg.feature_dims as f64;
+    input + cfg.layers as f64 * (linears + skeletal + temporal) + output
+}
+
+fn main() {
+    println!("| matmul n x n (f32, candle CPU, gemm x86-v4) | GFLOP/s |");
+    println!("|---|---|");
+    let mut peak: f64 = 0.0;
+    for n in [256, 512, 1024] {
+        let g = matmul_gflops(n);
+        peak = peak.max(g);
+        println!("| {n} | {g:.1} |");
+    }
+    println!();
+
+    let presets: Vec<String> = std::env::var("NN_BENCH_PRESETS")
+        .unwrap_or_else(|_| "tiny,small,paper".to_string())
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .collect();
+    let dev = Device::Cpu;
+    let (b, frames) = (8usize, 40usize);
+    println!("Batch: {b} skeletons with 25..60 joints (padded to 60), {frames} frames + P_S; threads: {}", rayon::current_num_threads());
+    println!();
+    println!("| preset | params | forward ms | fwd+bwd ms | fwd+bwd GFLOP/s | of matmul peak |");
+    println!("|---|---|---|---|---|---|");
+    for name in presets {
+        let cfg = match name.as_str() {
+            "tiny" => DenoiserConfig::tiny(),
+            "small" => DenoiserConfig::small(),
+            "paper" => DenoiserConfig::paper(),
+            other => {
+                println!("unknown preset {other}, skipped");
+                continue;
+            }
+        };
+        let mut rng = SplitMix64::new(1);
+        let clips: Vec<Clip> = (0..b).map(|i| clip(25 + i * 5, frames, cfg.name_dim, &mut rng)).collect();
+        let items: Vec<BatchItem> = clips
+            .iter()
+            .map(|c| BatchItem { features: &c.features, rest_row: &c.rest, relations: &c.relations, distances: &c.distances, names: &c.names, start: 0 })
+            .collect();
+        let steps: Vec<u32> = (0..b as u32).map(|i| i * 12).collect();
+        let batch = batch_from(&items, &steps, &dev).unwrap();
+        let vm = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&vm, 0, &dev), &cfg).unwrap();
+        let (_, t, j, _) = batch.dims().unwrap();
+        let flops = forward_flops(&cfg, b, t, j);
+        // One warm-up, then fewer runs when a step takes seconds.
+        let warm = Instant::now();
+        black_box(model.forward(&batch).unwrap());
+        let runs = if warm.elapsed() > Duration::from_secs(2) { 3 } else { common::RUNS };
+        let timed = |f: &dyn Fn()| {
+            let mut v: Vec<Duration> = (0..runs)
+                .map(|_| {
+                    let s = Instant::now();
+                    f();
+                    s.elapsed()
+                })
+                .collect();
+            v.sort();
+            v[v.len() / 2]
+        };
+        let fwd = timed(&|| {
+            black_box(model.forward(&batch).unwrap());
+        });
+        let step = timed(&|| {
+            let y = model.forward(&batch).unwrap();
+            let loss = y.sqr().unwrap().mean_all().unwrap();
+            black_box(loss.backward().unwrap());
+        });
+        let gflops = 3.0 * flops / step.as_secs_f64() / 1e9;
+        println!(
+            "| {name} | {} | {:.1} | {:.1} | {:.1} | {:.0}% |",
+            cfg.parameter_count(),
+            ms(fwd),
+            ms(step),
+            gflops,
+            100.0 * gflops / peak
+        );
+    }
+}

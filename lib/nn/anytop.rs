@@ -1,0 +1,326 @@
+//! AnyTop's denoiser (paper §3.2, reference facts in anytop.md §2): predicts the clean motion
+//! x0 from a noised motion, the diffusion step and the skeleton.
+//!
+//! 1. Enrichment: each joint token is projected to `width` by its own linear (root and other
+//!    joints separately, the rest-pose token P_S at t = 0 separately from motion frames); the
+//!    projected joint-name embedding is added to every token of that joint; a sinusoidal
+//!    temporal position is added per token (0 for P_S, k + 1 + crop start for frame k).
+//! 2. `layers` skeletal-temporal layers, post-norm as the reference:
+//!    `x += W_t·temb` (per-layer linear of the sinusoidal step embedding — the reference has no
+//!    other timestep MLP); `x = LN1(x + SkeletalAttn(x))` over the joints of each frame with the
+//!    GRPE topology terms; `x = LN2(x + TemporalAttn(x))` over the tokens of each joint within
+//!    the window; `x = LN3(x + FF(x))`. No final norm.
+//! 3. Output: root and other joints projected back to `feature_dims` by their own linears.
+//!
+//! Skeletal attention logits for head h, query joint i, key joint j (anytop.md §2.4):
+//! `(q_i·k_j + q_i·EqD[D_ij] + k_i·EkD[D_ij] + q_i·EqR[R_ij] + k_i·EkR[R_ij]) / sqrt(head_dim)`.
+//! The key-side terms use k at the *query's* joint i, as the reference (GRPE's indexing) does;
+//! the paper's formula writes k_j. Because every bias term is then a function of (i, type), it
+//! is computed as one small matmul per token against the one-hot of (D_ij, R_ij).
+//!
+//! Padding (fixes the reference's mask-ordering bug, §9.1): padded joints are masked as keys
+//! of the skeletal attention (per sample), padded frames as keys of the temporal attention,
+//! padded inputs are zeroed and padded outputs are zero. Real joints of a sample never see
+//! padding nor other samples, so a padded batch gives each clip the output it gets alone.
+
+use super::config::{DenoiserConfig, RELATION_TYPES};
+use super::layers::{merge_heads, sinusoid, split_heads, window_mask, FeedForward, LayerNorm, Linear, MASKED};
+use super::{Batch, NnError};
+use candle_core::{DType, Tensor, D};
+use candle_nn::{Init, VarBuilder};
+
+/// Per-forward tensors shared by all layers.
+struct Context {
+    b: usize,
+    t: usize,
+    j: usize,
+    /// One-hot of (D, R) per (sample, query joint), transposed for the bias matmul:
+    /// `[B*J, dmax+1+6, J]`.
+    topology: Tensor,
+    /// Additive key mask for skeletal attention, `[B, 1, 1, 1, J]`.
+    joint_keys: Tensor,
+    /// Additive window-and-padding mask for temporal attention, `[B, 1, 1, T, T]`.
+    temporal: Tensor,
+}
+
+#[derive(Clone, Debug)]
+struct SkeletalAttention {
+    query: Linear,
+    key: Linear,
+    value: Linear,
+    out: Linear,
+    heads: usize,
+}
+
+impl SkeletalAttention {
+    fn new(vb: VarBuilder, cfg: &DenoiserConfig) -> candle_core::Result<SkeletalAttention> {
+        let d = cfg.width;
+        Ok(SkeletalAttention {
+            query: Linear::new(vb.pp("query"), d, d)?,
+            key: Linear::new(vb.pp("key"), d, d)?,
+            value: Linear::new(vb.pp("value"), d, d)?,
+            out: Linear::new(vb.pp("out"), d, d)?,
+            heads: cfg.heads,
+        })
+    }
+
+    /// `x`: `[B, T, J, d]`; `eq`/`ek`: topology tables per head `[H, dh, types]`.
+    fn forward(&self, x: &Tensor, ctx: &Context, eq: &Tensor, ek: &Tensor) -> candle_core::Result<Tensor> {
+        let (b, t, j, h) = (ctx.b, ctx.t, ctx.j, self.heads);
+        let d = x.dim(D::Minus1)?;
+        let rows = x.reshape((b * t, j, d))?;
+        let q = split_heads(&self.query.forward(&rows)?, h)?; // [B*T, H, J, dh]
+        let k = split_heads(&self.key.forward(&rows)?, h)?;
+        let v = split_heads(&self.value.forward(&rows)?, h)?;
+        let dh = d / h;
+        let types = eq.dim(D::Minus1)?;
+        // c[bt, h, i, type] = q_i·Eq[type] + k_i·Ek[type]; bias[i, j] = c[i, type(i, j)] for
+        // both the distance and the relation type, summed.
+        let c = (q.broadcast_matmul(eq)? + k.broadcast_matmul(ek)?)?; // [B*T, H, J, types]
+        let c = c.reshape((b, t, h, j, types))?.permute((0, 3, 1, 2, 4))?.contiguous()?.reshape((b * j, t * h, types))?;
+        let bias = c.matmul(&ctx.topology)?; // [B*J, T*H, J]
+        let bias = bias.reshape((b, j, t, h, j))?.permute((0, 2, 3, 1, 4))?; // [B, T, H, J(i), J(j)]
+        let scale = 1.0 / (dh as f64).sqrt();
+        let logits = ((q.matmul(&k.t()?)?.reshape((b, t, h, j, j))? + bias)? * scale)?.broadcast_add(&ctx.joint_keys)?;
+        let p = super::layers::softmax(&logits)?.reshape((b * t, h, j, j))?;
+        let y = merge_heads(&p.matmul(&v)?)?; // [B*T, J, d]
+        self.out.forward(&y)?.reshape((b, t, j, d))
+    }
+}
+
+#[derive(Clone, Debug)]
+struct TemporalAttention {
+    query: Linear,
+    key: Linear,
+    value: Linear,
+    out: Linear,
+    heads: usize,
+}
+
+impl TemporalAttention {
+    fn new(vb: VarBuilder, cfg: &DenoiserConfig) -> candle_core::Result<TemporalAttention> {
+        let d = cfg.width;
+        Ok(TemporalAttention {
+            query: Linear::new(vb.pp("query"), d, d)?,
+            key: Linear::new(vb.pp("key"), d, d)?,
+            value: Linear::new(vb.pp("value"), d, d)?,
+            out: Linear::new(vb.pp("out"), d, d)?,
+            heads: cfg.heads,
+        })
+    }
+
+    fn forward(&self, x: &Tensor, ctx: &Context) -> candle_core::Result<Tensor> {
+        let (b, t, j, h) = (ctx.b, ctx.t, ctx.j, self.heads);
+        let d = x.dim(D::Minus1)?;
+        let rows = x.permute((0, 2, 1, 3))?.contiguous()?.reshape((b * j, t, d))?;
+        let q = split_heads(&self.query.forward(&rows)?, h)?; // [B*J, H, T, dh]
+        let k = split_heads(&self.key.forward(&rows)?, h)?;
+        let v = split_heads(&self.value.forward(&rows)?, h)?;
+        let scale = 1.0 / ((d / h) as f64).sqrt();
+        let logits = (q.matmul(&k.t()?)? * scale)?.reshape((b, j, h, t, t))?.broadcast_add(&ctx.temporal)?;
+        let p = super::layers::softmax(&logits)?.reshape((b * j, h, t, t))?;
+        let y = merge_heads(&p.matmul(&v)?)?; // [B*J, T, d]
+        self.out.forward(&y)?.reshape((b, j, t, d))?.permute((0, 2, 1, 3))?.contiguous()
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Layer {
+    timestep: Linear,
+    skeletal: SkeletalAttention,
+    temporal: TemporalAttention,
+    ff: FeedForward,
+    norm1: LayerNorm,
+    norm2: LayerNorm,
+    norm3: LayerNorm,
+}
+
+impl Layer {
+    fn new(vb: VarBuilder, cfg: &DenoiserConfig) -> candle_core::Result<Layer> {
+        let d = cfg.width;
+        Ok(Layer {
+            timestep: Linear::new(vb.pp("timestep"), d, d)?,
+            skeletal: SkeletalAttention::new(vb.pp("skeletal"), cfg)?,
+            temporal: TemporalAttention::new(vb.pp("temporal"), cfg)?,
+            ff: FeedForward::new(vb.pp("ff"), d, cfg.ff)?,
+            norm1: LayerNorm::new(vb.pp("norm1"), d, cfg.ln_eps)?,
+            norm2: LayerNorm::new(vb.pp("norm2"), d, cfg.ln_eps)?,
+            norm3: LayerNorm::new(vb.pp("norm3"), d, cfg.ln_eps)?,
+        })
+    }
+
+    /// `temb`: `[B, 1, 1, d]`.
+    fn forward(&self, x: &Tensor, temb: &Tensor, ctx: &Context, eq: &Tensor, ek: &Tensor) -> candle_core::Result<Tensor> {
+        let x = x.broadcast_add(&self.timestep.forward(temb)?)?;
+        let x = self.norm1.forward(&(&x + self.skeletal.forward(&x, ctx, eq, ek)?)?)?;
+        let x = self.norm2.forward(&(&x + self.temporal.forward(&x, ctx)?)?)?;
+        self.norm3.forward(&(&x + self.ff.forward(&x)?)?)
+    }
+}
+
+/// Root (joint 0) and other joints through separate linears, as the reference.
+#[derive(Clone, Debug)]
+struct PerJointType {
+    root: Linear,
+    joint: Linear,
+}
+
+impl PerJointType {
+    fn new(vb: VarBuilder, inputs: usize, outputs: usize) -> candle_core::Result<PerJointType> {
+        Ok(PerJointType { root: Linear::new(vb.pp("root"), inputs, outputs)?, joint: Linear::new(vb.pp("joint"), inputs, outputs)? })
+    }
+
+    /// `x`: `[B, T, J, inputs]` -> `[B, T, J, outputs]`.
+    fn forward(&self, x: &Tensor) -> candle_core::Result<Tensor> {
+        let j = x.dim(2)?;
+        let root = self.root.forward(&x.narrow(2, 0, 1)?)?;
+        if j == 1 {
+            return Ok(root);
+        }
+        let rest = self.joint.forward(&x.narrow(2, 1, j - 1)?)?;
+        Tensor::cat(&[root, rest], 2)
+    }
+}
+
+/// `x` where `mask` (broadcast to `x`) is non-zero, 0 elsewhere.
+fn zero_where_masked(x: &Tensor, mask: &Tensor) -> candle_core::Result<Tensor> {
+    let keep = mask.ne(0f32)?.broadcast_as(x.shape())?.contiguous()?;
+    keep.where_cond(x, &x.zeros_like()?)
+}
+
+#[derive(Clone, Debug)]
+pub struct Denoiser {
+    cfg: DenoiserConfig,
+    motion_in: PerJointType,
+    rest_in: PerJointType,
+    names_in: Linear,
+    distance_query: Tensor,
+    distance_key: Tensor,
+    relation_query: Tensor,
+    relation_key: Tensor,
+    layers: Vec<Layer>,
+    out: PerJointType,
+}
+
+impl Denoiser {
+    /// Builds (or loads, depending on `vb`'s backend) the parameters, named
+    /// `input.{motion,rest}.{root,joint}`, `input.names`, `topology.{distance,relation}_{query,key}`,
+    /// `layers.<l>.{timestep,skeletal.*,temporal.*,ff.{up,down},norm1..3}`, `output.{root,joint}`.
+    /// Use [`super::seeded_var_builder`] for a reproducible fresh model.
+    pub fn new(vb: VarBuilder, cfg: &DenoiserConfig) -> Result<Denoiser, NnError> {
+        cfg.validate()?;
+        let d = cfg.width;
+        let input = vb.pp("input");
+        let topo = vb.pp("topology");
+        // PyTorch's nn.Embedding default, N(0, 1), as the reference's four tables.
+        let table = |name: &str, rows: usize| topo.get_with_hints((rows, d), name, Init::Randn { mean: 0.0, stdev: 1.0 });
+        Ok(Denoiser {
+            cfg: cfg.clone(),
+            motion_in: PerJointType::new(input.pp("motion"), cfg.feature_dims, d)?,
+            rest_in: PerJointType::new(input.pp("rest"), cfg.feature_dims, d)?,
+            names_in: Linear::new(input.pp("names"), cfg.name_dim, d)?,
+            distance_query: table("distance_query", cfg.dmax + 1)?,
+            distance_key: table("distance_key", cfg.dmax + 1)?,
+            relation_query: table("relation_query", RELATION_TYPES)?,
+            relation_key: table("relation_key", RELATION_TYPES)?,
+            layers: (0..cfg.layers).map(|l| Layer::new(vb.pp("layers").pp(l), cfg)).collect::<candle_core::Result<_>>()?,
+            out: PerJointType::new(vb.pp("output"), d, cfg.feature_dims)?,
+        })
+    }
+
+    pub fn config(&self) -> &DenoiserConfig {
+        &self.cfg
+    }
+
+    /// x0 prediction `[B, T, J, dims]`. Token 0 echoes the input rest-pose row P_S unchanged
+    /// (it is conditioning, not predicted), so the output lines up with `batch.x`; padded
+    /// joints and frames are 0.
+    pub fn forward(&self, batch: &Batch) -> Result<Tensor, NnError> {
+        Ok(self.forward_with_activations(batch, &[])?.0)
+    }
+
+    /// `forward` plus the activations after each layer in `keep_layers` (0-based, in the given
+    /// order), each `[B, T, J, width]` including the P_S token — DIFT features.
+    pub fn forward_with_activations(&self, batch: &Batch, keep_layers: &[usize]) -> Result<(Tensor, Vec<Tensor>), NnError> {
+        if let Some(&l) = keep_layers.iter().find(|&&l| l >= self.cfg.layers) {
+            return Err(NnError::Layer { requested: l, layers: self.cfg.layers });
+        }
+        let (b, t, j) = self.check(batch)?;
+        let ctx = self.context(batch, b, t, j)?;
+        let token_mask = batch.frame_mask.reshape((b, t, 1, 1))?.broadcast_mul(&batch.joint_mask.reshape((b, 1, j, 1))?)?;
+        // Replacing padded inputs by zeros (a select, not a product: NaN * 0 is NaN) keeps them
+        // finite whatever the caller left there; a NaN or inf would survive multiplication by a
+        // zero attention weight.
+        let x = zero_where_masked(&batch.x, &token_mask)?;
+        let rest = self.rest_in.forward(&x.narrow(1, 0, 1)?)?;
+        let motion = self.motion_in.forward(&x.narrow(1, 1, t - 1)?)?;
+        let names = zero_where_masked(&batch.names, &batch.joint_mask.unsqueeze(2)?)?;
+        let mut h = Tensor::cat(&[rest, motion], 1)?
+            .broadcast_add(&self.names_in.forward(&names)?.unsqueeze(1)?)?
+            .broadcast_add(&sinusoid(&batch.positions, self.cfg.width)?.unsqueeze(2)?)?;
+        let temb = sinusoid(&batch.timesteps.to_dtype(DType::F32)?, self.cfg.width)?.reshape((b, 1, 1, self.cfg.width))?;
+        let (eq, ek) = self.topology_tables()?;
+        let mut kept = vec![None; keep_layers.len()];
+        for (l, layer) in self.layers.iter().enumerate() {
+            h = layer.forward(&h, &temb, &ctx, &eq, &ek)?;
+            for (slot, _) in keep_layers.iter().enumerate().filter(|(_, &k)| k == l) {
+                kept[slot] = Some(h.clone());
+            }
+        }
+        let y = self.out.forward(&h.narrow(1, 1, t - 1)?)?;
+        let y = Tensor::cat(&[x.narrow(1, 0, 1)?, y], 1)?.broadcast_mul(&token_mask)?;
+        Ok((y, kept.into_iter().flatten().collect()))
+    }
+
+    /// Shapes of every batch tensor against `x`'s `(B, T, J)`.
+    fn check(&self, batch: &Batch) -> Result<(usize, usize, usize), NnError> {
+        let shape = |what: &'static str, t: &Tensor, want: &[usize]| -> Result<(), NnError> {
+            if t.dims() != want {
+                return Err(NnError::Shape { what, expected: format!("{want:?}"), got: t.dims().to_vec() });
+            }
+            Ok(())
+        };
+        let dims = batch.x.dims();
+        if dims.len() != 4 || dims[3] != self.cfg.feature_dims || dims[1] < 2 || dims[0] == 0 || dims[2] == 0 {
+            return Err(NnError::Shape { what: "x", expected: format!("[B>0, T>=2, J>0, {}]", self.cfg.feature_dims), got: dims.to_vec() });
+        }
+        let (b, t, j) = (dims[0], dims[1], dims[2]);
+        shape("timesteps", &batch.timesteps, &[b])?;
+        shape("names", &batch.names, &[b, j, self.cfg.name_dim])?;
+        shape("relations", &batch.relations, &[b, j, j])?;
+        shape("distances", &batch.distances, &[b, j, j])?;
+        shape("joint_mask", &batch.joint_mask, &[b, j])?;
+        shape("frame_mask", &batch.frame_mask, &[b, t])?;
+        shape("positions", &batch.positions, &[b, t])?;
+        Ok((b, t, j))
+    }
+
+    fn context(&self, batch: &Batch, b: usize, t: usize, j: usize) -> Result<Context, NnError> {
+        let dev = batch.x.device();
+        let one_hot = |m: &Tensor, n: usize| -> candle_core::Result<Tensor> {
+            let ids = Tensor::arange(0u32, n as u32, dev)?;
+            m.to_dtype(DType::U32)?.unsqueeze(D::Minus1)?.broadcast_eq(&ids)?.to_dtype(DType::F32)
+        };
+        // Distances beyond dmax share the dmax row; an unknown relation id (> 5) adds no bias.
+        let dist = batch.distances.to_dtype(DType::U32)?.clamp(0u32, self.cfg.dmax as u32)?;
+        let topology = Tensor::cat(&[one_hot(&dist, self.cfg.dmax + 1)?, one_hot(&batch.relations, RELATION_TYPES)?], D::Minus1)?; // [B, J, J, types]
+        let types = topology.dim(D::Minus1)?;
+        let topology = topology.transpose(2, 3)?.contiguous()?.reshape((b * j, types, j))?;
+        let joint_keys = ((batch.joint_mask.to_dtype(DType::F32)? - 1.0)? * -MASKED)?.reshape((b, 1, 1, 1, j))?;
+        let window = window_mask(t, self.cfg.window, dev)?;
+        let allowed = window.unsqueeze(0)?.broadcast_mul(&batch.frame_mask.to_dtype(DType::F32)?.unsqueeze(1)?)?; // [B, T(query), T(key)]
+        let temporal = ((allowed - 1.0)? * -MASKED)?.reshape((b, 1, 1, t, t))?;
+        Ok(Context { b, t, j, topology, joint_keys, temporal })
+    }
+
+    /// The query and key tables per head, `[H, dh, (dmax+1) + 6]` each (distance rows first).
+    fn topology_tables(&self) -> candle_core::Result<(Tensor, Tensor)> {
+        let (h, dh) = (self.cfg.heads, self.cfg.head_dim());
+        let per_head = |a: &Tensor, b: &Tensor| -> candle_core::Result<Tensor> {
+            let both = Tensor::cat(&[a, b], 0)?; // [types, d]
+            let types = both.dim(0)?;
+            both.reshape((types, h, dh))?.permute((1, 2, 0))?.contiguous()
+        };
+        Ok((per_head(&self.distance_query, &self.relation_query)?, per_head(&self.distance_key, &self.relation_key)?))
+    }
+}

@@ -1,0 +1,225 @@
+//! Building blocks made only of basic differentiable tensor ops.
+//!
+//! Why not `candle_nn::{LayerNorm, ops::softmax_last_dim, ops::sdpa}`: their fused CPU kernels
+//! are custom ops without a backward pass, so training through them silently leaves earlier
+//! parameters without gradients. Everything here is matmuls, broadcasts, `exp`, sums and means,
+//! which candle's autograd differentiates; `nn::anytop`'s gradient test checks every parameter.
+
+use candle_core::{DType, Device, Result, Tensor, D};
+use candle_nn::{Init, VarBuilder};
+
+/// Additive value for disallowed attention entries. `exp(-1e9 - max)` underflows to exactly 0
+/// in f32, so masked keys contribute nothing (not merely little) as long as a row keeps one
+/// allowed key, which every row of ours does (the rest-pose token, or the joint itself).
+pub const MASKED: f64 = -1e9;
+
+/// `y = x W^T + b` over the last dimension, for inputs of any rank (flattened to one GEMM).
+#[derive(Clone, Debug)]
+pub struct Linear {
+    weight: Tensor,
+    bias: Tensor,
+    inputs: usize,
+    outputs: usize,
+}
+
+impl Linear {
+    /// PyTorch's default init (uniform in ±1/sqrt(fan_in) for weight and bias), which the
+    /// reference model was trained with.
+    pub fn new(vb: VarBuilder, inputs: usize, outputs: usize) -> Result<Linear> {
+        let bound = 1.0 / (inputs.max(1) as f64).sqrt();
+        let init = Init::Uniform { lo: -bound, up: bound };
+        let weight = vb.get_with_hints((outputs, inputs), "weight", init)?;
+        let bias = vb.get_with_hints(outputs, "bias", init)?;
+        Ok(Linear { weight, bias, inputs, outputs })
+    }
+
+    pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
+        let dims = x.dims().to_vec();
+        let rows: usize = dims[..dims.len().saturating_sub(1)].iter().product();
+        let flat = x.reshape((rows, self.inputs))?;
+        let y = flat.matmul(&self.weight.t()?)?.broadcast_add(&self.bias)?;
+        let mut out = dims;
+        if let Some(last) = out.last_mut() {
+            *last = self.outputs;
+        }
+        y.reshape(out)
+    }
+}
+
+/// Layer norm over the last dimension with learned scale and shift (eps 1e-5 as PyTorch).
+#[derive(Clone, Debug)]
+pub struct LayerNorm {
+    weight: Tensor,
+    bias: Tensor,
+    eps: f64,
+}
+
+impl LayerNorm {
+    pub fn new(vb: VarBuilder, width: usize, eps: f64) -> Result<LayerNorm> {
+        let weight = vb.get_with_hints(width, "weight", Init::Const(1.0))?;
+        let bias = vb.get_with_hints(width, "bias", Init::Const(0.0))?;
+        Ok(LayerNorm { weight, bias, eps })
+    }
+
+    pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
+        let mean = x.mean_keepdim(D::Minus1)?;
+        let centred = x.broadcast_sub(&mean)?;
+        let var = centred.sqr()?.mean_keepdim(D::Minus1)?;
+        let normed = centred.broadcast_div(&(var + self.eps)?.sqrt()?)?;
+        normed.broadcast_mul(&self.weight)?.broadcast_add(&self.bias)
+    }
+}
+
+/// Softmax over the last dimension: `exp(x - max) / sum`. The max is detached: the result does
+/// not depend on the shift, so no gradient has to flow through it.
+pub fn softmax(x: &Tensor) -> Result<Tensor> {
+    let max = x.max_keepdim(D::Minus1)?.detach();
+    let e = x.broadcast_sub(&max)?.exp()?;
+    let sum = e.sum_keepdim(D::Minus1)?;
+    e.broadcast_div(&sum)
+}
+
+/// The feed-forward block: `Linear(d -> ff) -> GELU (erf form, as the reference) -> Linear(ff -> d)`.
+#[derive(Clone, Debug)]
+pub struct FeedForward {
+    up: Linear,
+    down: Linear,
+}
+
+impl FeedForward {
+    pub fn new(vb: VarBuilder, width: usize, hidden: usize) -> Result<FeedForward> {
+        Ok(FeedForward { up: Linear::new(vb.pp("up"), width, hidden)?, down: Linear::new(vb.pp("down"), hidden, width)? })
+    }
+
+    pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
+        self.down.forward(&self.up.forward(x)?.gelu_erf()?)
+    }
+}
+
+/// Sinusoidal embedding of positions (or diffusion steps) as the reference computes it
+/// (anytop.md §2.2): half = width/2, phi_i = p / 10000^(i/(half-1)), output `[cos phi, sin phi]`
+/// (cos block first). `positions` is f32 of any shape `S`; the result is `S x width`.
+/// Odd widths get one trailing zero column.
+pub fn sinusoid(positions: &Tensor, width: usize) -> Result<Tensor> {
+    let half = width / 2;
+    let device = positions.device();
+    let denom = (half.max(2) - 1) as f64;
+    let freqs: Vec<f32> = (0..half).map(|i| (10000f64.powf(-(i as f64) / denom)) as f32).collect();
+    let freqs = Tensor::from_vec(freqs, half, device)?;
+    let phi = positions.to_dtype(DType::F32)?.unsqueeze(D::Minus1)?.broadcast_mul(&freqs)?;
+    let mut parts = vec![phi.cos()?, phi.sin()?];
+    if width % 2 == 1 {
+        let mut shape = phi.dims().to_vec();
+        if let Some(last) = shape.last_mut() {
+            *last = 1;
+        }
+        parts.push(Tensor::zeros(shape, DType::F32, device)?);
+    }
+    Tensor::cat(&parts, D::Minus1)
+}
+
+/// Multi-head scaled dot-product attention from matmuls, with an additive bias/mask that
+/// broadcasts against the logits. `q, k, v`: `[N, heads, L, head_dim]`; `logits_bias` is added
+/// after the 1/sqrt(head_dim) scaling. Returns `[N, heads, L, head_dim]`.
+pub fn attention(q: &Tensor, k: &Tensor, v: &Tensor, logits: Option<&Tensor>, scale: f64) -> Result<Tensor> {
+    let mut scores = (q.matmul(&k.t()?)? * scale)?;
+    if let Some(extra) = logits {
+        scores = scores.broadcast_add(extra)?;
+    }
+    softmax(&scores)?.matmul(v)
+}
+
+/// `[rows, L, width]` -> `[rows, heads, L, width/heads]` (contiguous, ready for matmul).
+pub fn split_heads(x: &Tensor, heads: usize) -> Result<Tensor> {
+    let (rows, len, width) = x.dims3()?;
+    x.reshape((rows, len, heads, width / heads))?.transpose(1, 2)?.contiguous()
+}
+
+/// Inverse of [`split_heads`].
+pub fn merge_heads(x: &Tensor) -> Result<Tensor> {
+    let (rows, heads, len, dh) = x.dims4()?;
+    x.transpose(1, 2)?.contiguous()?.reshape((rows, len, heads * dh))
+}
+
+/// A 0/1 f32 tensor `[len, len]`: 1 where query i may attend key k in the windowed temporal
+/// attention: |i - k| <= window/2, or k == 0 (every token sees the rest-pose token, §2.5).
+/// The reference's window is [i-15, i+16], one wider on the right; we keep it symmetric.
+pub fn window_mask(len: usize, window: usize, device: &Device) -> Result<Tensor> {
+    let half = window / 2;
+    let mut m = vec![0f32; len * len];
+    for i in 0..len {
+        for k in 0..len {
+            if k == 0 || i.abs_diff(k) <= half {
+                m[i * len + k] = 1.0;
+            }
+        }
+    }
+    Tensor::from_vec(m, (len, len), device)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use candle_core::Var;
+
+    #[test]
+    fn softmax_matches_closed_form_and_has_gradient() {
+        let dev = Device::Cpu;
+        let x = Var::from_vec(vec![1f32, 2.0, 3.0, -1.0, 0.0, 50.0], (2, 3), &dev).unwrap();
+        let y = softmax(x.as_tensor()).unwrap();
+        let rows = y.to_vec2::<f32>().unwrap();
+        let e: Vec<f32> = [1f32, 2.0, 3.0].iter().map(|v| (v - 3.0).exp()).collect();
+        let s: f32 = e.iter().sum();
+        for (a, b) in rows[0].iter().zip(e.iter()) {
+            assert!((a - b / s).abs() < 1e-6);
+        }
+        assert!((rows[1][2] - 1.0).abs() < 1e-6, "large logits must not overflow: {:?}", rows[1]);
+        // Weighted sum so the gradient is not identically zero (sum of softmax is constant).
+        let w = Tensor::new(&[[1f32, 0.0, 0.0], [0.0, 1.0, 0.0]], &dev).unwrap();
+        let g = y.mul(&w).unwrap().sum_all().unwrap().backward().unwrap();
+        let gx = g.get(x.as_tensor()).expect("softmax must pass a gradient");
+        assert!(gx.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap() > 1e-8);
+    }
+
+    #[test]
+    fn layer_norm_normalises_and_has_gradient() {
+        let dev = Device::Cpu;
+        let vm = candle_nn::VarMap::new();
+        let vb = VarBuilder::from_varmap(&vm, DType::F32, &dev);
+        let ln = LayerNorm::new(vb, 4, 1e-5).unwrap();
+        let x = Var::from_vec(vec![1f32, 2.0, 3.0, 10.0], (1, 4), &dev).unwrap();
+        let y = ln.forward(x.as_tensor()).unwrap();
+        let v = y.to_vec2::<f32>().unwrap()[0].clone();
+        let mean: f32 = v.iter().sum::<f32>() / 4.0;
+        let var: f32 = v.iter().map(|a| (a - mean) * (a - mean)).sum::<f32>() / 4.0;
+        assert!(mean.abs() < 1e-5 && (var - 1.0).abs() < 1e-3, "mean {mean} var {var}");
+        let w = Tensor::new(&[[1f32, -2.0, 0.5, 3.0]], &dev).unwrap();
+        let g = y.mul(&w).unwrap().sum_all().unwrap().backward().unwrap();
+        for var in vm.all_vars() {
+            let gv = g.get(var.as_tensor()).expect("layer norm parameters must get a gradient");
+            assert!(gv.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap() > 1e-8);
+        }
+        assert!(g.get(x.as_tensor()).is_some());
+    }
+
+    #[test]
+    fn window_mask_is_symmetric_band_plus_rest_token() {
+        let m = window_mask(40, 31, &Device::Cpu).unwrap().to_vec2::<f32>().unwrap();
+        assert_eq!(m[20][5], 1.0);
+        assert_eq!(m[20][35], 1.0);
+        assert_eq!(m[20][4], 0.0);
+        assert_eq!(m[20][36], 0.0);
+        assert_eq!(m[39][0], 1.0, "the rest-pose token is always visible");
+        assert_eq!(m[39][8], 0.0);
+    }
+
+    #[test]
+    fn sinusoid_is_cos_then_sin() {
+        let p = Tensor::new(&[0f32, 3.0], &Device::Cpu).unwrap();
+        let e = sinusoid(&p, 8).unwrap().to_vec2::<f32>().unwrap();
+        assert_eq!(e[0], vec![1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0]);
+        assert!((e[1][0] - 3f32.cos()).abs() < 1e-6 && (e[1][4] - 3f32.sin()).abs() < 1e-6);
+        // Last frequency is 1/10000 because of the division by half-1.
+        assert!((e[1][7] - (3e-4f32).sin()).abs() < 1e-7);
+    }
+}
