@@ -8,6 +8,13 @@
 //!    (backward = 2x forward), so `fwd+bwd GFLOP/s / matmul peak` is the FLOP utilisation.
 //!
 //! Set `NN_BENCH_PRESETS=tiny,small` to skip presets; medians of `RUNS` runs (fewer for slow ones).
+//!
+//! Measured here (2 shared cores): the time goes to element-wise passes over the J x J and
+//! T x T attention maps and to fresh allocations (page faults, memset), not to matmuls.
+//! glibc's allocator returning large blocks to the OS costs a lot: with
+//! `MALLOC_MMAP_THRESHOLD_=4294967295 MALLOC_TRIM_THRESHOLD_=4294967295 MALLOC_TOP_PAD_=268435456`
+//! the tiny forward on `8 x 25..60` went from ~0.8-1.2 s to ~0.42 s and the step from ~2.0 s to
+//! ~1.66 s (a training binary can set the same with `mallopt`).
 
 mod common;
 use common::{median, ms, time_runs};
@@ -95,12 +102,20 @@ fn main() {
         .map(|s| s.trim().to_string())
         .collect();
     let dev = Device::Cpu;
-    let (b, frames) = (8usize, 40usize);
-    println!("Batch: {b} skeletons with 25..60 joints (padded to 60), {frames} frames + P_S; threads: {}", rayon::current_num_threads());
+    let frames = 40usize;
+    println!("Batches: `8 x 25..60`: 8 skeletons with 25, 30, .. 60 joints (padded to 60); `4 x 25`: one 25-joint");
+    println!("skeleton 4 times (an overfit run). {frames} frames + P_S. Threads: {}", rayon::current_num_threads());
     println!();
-    println!("| preset | params | forward ms | fwd+bwd ms | fwd+bwd GFLOP/s | of matmul peak |");
-    println!("|---|---|---|---|---|---|");
+    println!("| preset | batch | params | forward ms | fwd+bwd ms | fwd+bwd GFLOP/s | of matmul peak |");
+    println!("|---|---|---|---|---|---|---|");
+    let mut cases: Vec<(String, usize, bool)> = Vec::new();
     for name in presets {
+        if name == "tiny" {
+            cases.push((name.clone(), 4, false));
+        }
+        cases.push((name, 8, true));
+    }
+    for (name, b, mixed) in cases {
         let cfg = match name.as_str() {
             "tiny" => DenoiserConfig::tiny(),
             "small" => DenoiserConfig::small(),
@@ -110,8 +125,12 @@ fn main() {
                 continue;
             }
         };
-        let mut rng = SplitMix64::new(1);
-        let clips: Vec<Clip> = (0..b).map(|i| clip(25 + i * 5, frames, cfg.name_dim, &mut rng)).collect();
+        let clips: Vec<Clip> = (0..b)
+            .map(|i| {
+                let mut rng = if mixed { SplitMix64::new(i as u64) } else { SplitMix64::new(0) };
+                clip(if mixed { 25 + i * 5 } else { 25 }, frames, cfg.name_dim, &mut rng)
+            })
+            .collect();
         let items: Vec<BatchItem> = clips
             .iter()
             .map(|c| BatchItem { features: &c.features, rest_row: &c.rest, relations: &c.relations, distances: &c.distances, names: &c.names, start: 0 })
@@ -147,7 +166,8 @@ fn main() {
         });
         let gflops = 3.0 * flops / step.as_secs_f64() / 1e9;
         println!(
-            "| {name} | {} | {:.1} | {:.1} | {:.1} | {:.0}% |",
+            "| {name} | {} | {} | {:.1} | {:.1} | {:.1} | {:.0}% |",
+            if mixed { format!("{b} x 25..60") } else { format!("{b} x 25") },
             cfg.parameter_count(),
             ms(fwd),
             ms(step),

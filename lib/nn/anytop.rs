@@ -34,11 +34,9 @@ struct Context {
     b: usize,
     t: usize,
     j: usize,
-    /// One-hot of (D, R) per (sample, query joint), transposed for the bias matmul:
-    /// `[B*J, dmax+1+6, J]`.
+    /// One-hot of (D, R) per (sample, query joint), transposed for the bias matmul, plus a
+    /// last row with the additive key-padding mask (0 or -1e9): `[B*J, dmax+1+6+1, J]`.
     topology: Tensor,
-    /// Additive key mask for skeletal attention, `[B, 1, 1, 1, J]`.
-    joint_keys: Tensor,
     /// Additive window-and-padding mask for temporal attention, `[B, 1, 1, T, T]`.
     temporal: Tensor,
 }
@@ -72,16 +70,22 @@ impl SkeletalAttention {
         let q = split_heads(&self.query.forward(&rows)?, h)?; // [B*T, H, J, dh]
         let k = split_heads(&self.key.forward(&rows)?, h)?;
         let v = split_heads(&self.value.forward(&rows)?, h)?;
-        let dh = d / h;
+        // The 1/sqrt(head_dim) scale is applied to the small operands (q and the topology
+        // coefficients) rather than to the J x J logits: the logits are the big tensors here
+        // and every pass over them costs (see benches/nn.rs).
+        let q = (q * (1.0 / ((d / h) as f64).sqrt()))?;
         let types = eq.dim(D::Minus1)?;
-        // c[bt, h, i, type] = q_i·Eq[type] + k_i·Ek[type]; bias[i, j] = c[i, type(i, j)] for
-        // both the distance and the relation type, summed.
-        let c = (q.broadcast_matmul(eq)? + k.broadcast_matmul(ek)?)?; // [B*T, H, J, types]
+        // c[bt, h, i, type] = q_i·Eq[type] + k_i·Ek[type] (scaled); bias[i, j] = c[i, type(i, j)]
+        // for both the distance and the relation type, summed, as a matmul against the
+        // one-hot of (D_ij, R_ij). A last column of ones picks up the key-padding mask, which
+        // the context stores as the last one-hot row, so the mask costs no extra pass.
+        let ek_scaled = (ek * (1.0 / ((d / h) as f64).sqrt()))?;
+        let c = (q.broadcast_matmul(eq)? + k.broadcast_matmul(&ek_scaled)?)?; // [B*T, H, J, types]
         let c = c.reshape((b, t, h, j, types))?.permute((0, 3, 1, 2, 4))?.contiguous()?.reshape((b * j, t * h, types))?;
+        let c = Tensor::cat(&[c, Tensor::ones((b * j, t * h, 1), DType::F32, x.device())?], 2)?;
         let bias = c.matmul(&ctx.topology)?; // [B*J, T*H, J]
         let bias = bias.reshape((b, j, t, h, j))?.permute((0, 2, 3, 1, 4))?; // [B, T, H, J(i), J(j)]
-        let scale = 1.0 / (dh as f64).sqrt();
-        let logits = ((q.matmul(&k.t()?)?.reshape((b, t, h, j, j))? + bias)? * scale)?.broadcast_add(&ctx.joint_keys)?;
+        let logits = (q.matmul(&k.t()?)?.reshape((b, t, h, j, j))? + bias)?;
         let p = super::layers::softmax(&logits)?.reshape((b * t, h, j, j))?;
         let y = merge_heads(&p.matmul(&v)?)?; // [B*T, J, d]
         self.out.forward(&y)?.reshape((b, t, j, d))
@@ -116,8 +120,8 @@ impl TemporalAttention {
         let q = split_heads(&self.query.forward(&rows)?, h)?; // [B*J, H, T, dh]
         let k = split_heads(&self.key.forward(&rows)?, h)?;
         let v = split_heads(&self.value.forward(&rows)?, h)?;
-        let scale = 1.0 / ((d / h) as f64).sqrt();
-        let logits = (q.matmul(&k.t()?)? * scale)?.reshape((b, j, h, t, t))?.broadcast_add(&ctx.temporal)?;
+        let q = (q * (1.0 / ((d / h) as f64).sqrt()))?;
+        let logits = q.matmul(&k.t()?)?.reshape((b, j, h, t, t))?.broadcast_add(&ctx.temporal)?;
         let p = super::layers::softmax(&logits)?.reshape((b * j, h, t, t))?;
         let y = merge_heads(&p.matmul(&v)?)?; // [B*J, T, d]
         self.out.forward(&y)?.reshape((b, j, t, d))?.permute((0, 2, 1, 3))?.contiguous()
@@ -303,14 +307,15 @@ impl Denoiser {
         };
         // Distances beyond dmax share the dmax row; an unknown relation id (> 5) adds no bias.
         let dist = batch.distances.to_dtype(DType::U32)?.clamp(0u32, self.cfg.dmax as u32)?;
-        let topology = Tensor::cat(&[one_hot(&dist, self.cfg.dmax + 1)?, one_hot(&batch.relations, RELATION_TYPES)?], D::Minus1)?; // [B, J, J, types]
+        let joint_keys = ((batch.joint_mask.to_dtype(DType::F32)? - 1.0)? * -MASKED)?.reshape((b, 1, j, 1))?.broadcast_as((b, j, j, 1))?;
+        let parts = [one_hot(&dist, self.cfg.dmax + 1)?, one_hot(&batch.relations, RELATION_TYPES)?, joint_keys.contiguous()?];
+        let topology = Tensor::cat(&parts, D::Minus1)?; // [B, J(i), J(j), types + 1]
         let types = topology.dim(D::Minus1)?;
         let topology = topology.transpose(2, 3)?.contiguous()?.reshape((b * j, types, j))?;
-        let joint_keys = ((batch.joint_mask.to_dtype(DType::F32)? - 1.0)? * -MASKED)?.reshape((b, 1, 1, 1, j))?;
         let window = window_mask(t, self.cfg.window, dev)?;
         let allowed = window.unsqueeze(0)?.broadcast_mul(&batch.frame_mask.to_dtype(DType::F32)?.unsqueeze(1)?)?; // [B, T(query), T(key)]
         let temporal = ((allowed - 1.0)? * -MASKED)?.reshape((b, 1, 1, t, t))?;
-        Ok(Context { b, t, j, topology, joint_keys, temporal })
+        Ok(Context { b, t, j, topology, temporal })
     }
 
     /// The query and key tables per head, `[H, dh, (dmax+1) + 6]` each (distance rows first).

@@ -118,17 +118,6 @@ pub fn sinusoid(positions: &Tensor, width: usize) -> Result<Tensor> {
     Tensor::cat(&parts, D::Minus1)
 }
 
-/// Multi-head scaled dot-product attention from matmuls, with an additive bias/mask that
-/// broadcasts against the logits. `q, k, v`: `[N, heads, L, head_dim]`; `logits_bias` is added
-/// after the 1/sqrt(head_dim) scaling. Returns `[N, heads, L, head_dim]`.
-pub fn attention(q: &Tensor, k: &Tensor, v: &Tensor, logits: Option<&Tensor>, scale: f64) -> Result<Tensor> {
-    let mut scores = (q.matmul(&k.t()?)? * scale)?;
-    if let Some(extra) = logits {
-        scores = scores.broadcast_add(extra)?;
-    }
-    softmax(&scores)?.matmul(v)
-}
-
 /// `[rows, L, width]` -> `[rows, heads, L, width/heads]` (contiguous, ready for matmul).
 pub fn split_heads(x: &Tensor, heads: usize) -> Result<Tensor> {
     let (rows, len, width) = x.dims3()?;

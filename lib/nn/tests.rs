@@ -276,3 +276,29 @@ fn bad_batches_are_typed_errors() {
     batch.names = Tensor::zeros((1, 6, 7), candle_core::DType::F32, &dev).unwrap();
     assert!(matches!(m.forward(&batch), Err(NnError::Shape { what: "names", .. })));
 }
+
+#[test]
+fn thread_count_does_not_change_the_bytes() {
+    // candle reads RAYON_NUM_THREADS on every matmul to split the work; setting it here races
+    // only with other tests' matmuls, which then also just run with another split — exactly
+    // what must not matter.
+    let cfg = DenoiserConfig::tiny();
+    let (vm, m) = model(&cfg, 31);
+    let weight = vm.data().lock().unwrap()["layers.0.skeletal.query.weight"].as_tensor().clone();
+    let (a, b) = (creature(9, 31), worm(6, 32));
+    let batch = batch_from(&[a.item(), b.item()], &[7, 77], &Device::Cpu).unwrap();
+    let before = std::env::var("RAYON_NUM_THREADS").ok();
+    let mut outs = Vec::new();
+    for threads in ["1", "3"] {
+        std::env::set_var("RAYON_NUM_THREADS", threads);
+        let y = m.forward(&batch).unwrap();
+        let g = y.sqr().unwrap().sum_all().unwrap().backward().unwrap();
+        let gw = values(g.get(&weight).unwrap());
+        outs.push((values(&y).iter().map(|v| v.to_bits()).collect::<Vec<_>>(), gw.iter().map(|v| v.to_bits()).collect::<Vec<_>>()));
+    }
+    match before {
+        Some(v) => std::env::set_var("RAYON_NUM_THREADS", v),
+        None => std::env::remove_var("RAYON_NUM_THREADS"),
+    }
+    assert!(outs[0] == outs[1], "1 and 3 threads give different bytes");
+}
