@@ -3,5 +3,6 @@
 
 pub mod data;
 pub mod schedule;
+pub mod train;
 
 pub use schedule::{Sampler, Schedule, Step};
