@@ -12,6 +12,8 @@ pub mod mo_encode;
 pub mod mo_metrics;
 pub mod mo_render;
 pub mod mo_retarget;
+pub mod mo_sample;
+pub mod mo_train;
 pub mod skel_aug;
 pub mod skel_info;
 
@@ -76,5 +78,7 @@ pub fn all_commands() -> Vec<clap::Command> {
         mo_retarget::Args::command(),
         mo_metrics::Args::command(),
         mo_render::Args::command(),
+        mo_train::Args::command(),
+        mo_sample::Args::command(),
     ]
 }

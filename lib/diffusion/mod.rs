@@ -1,7 +1,9 @@
 //! Diffusion for any skeleton (AnyTop §3): the noise schedule and sampler coefficients.
 //! The model itself is in `nn`; training and sampling loops build on both.
 
+pub mod checkpoint;
 pub mod data;
+pub mod sample;
 pub mod schedule;
 pub mod train;
 

@@ -61,6 +61,8 @@ pub fn bin(name: &str) -> Command {
         "mo-render" => env!("CARGO_BIN_EXE_mo-render"),
         "mo-metrics" => env!("CARGO_BIN_EXE_mo-metrics"),
         "mo-retarget" => env!("CARGO_BIN_EXE_mo-retarget"),
+        "mo-train" => env!("CARGO_BIN_EXE_mo-train"),
+        "mo-sample" => env!("CARGO_BIN_EXE_mo-sample"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);
