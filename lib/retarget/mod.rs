@@ -440,8 +440,12 @@ impl<'a> Plan<'a> {
             let bank = nn::Bank::new(cm, cp, &self.weights, self.patch);
             let mut level = LevelReport { frames: len, example_frames: bank.frames(), example_patches: bank.len(), ..LevelReport::default() };
             if bank.len() > 0 && len >= self.patch {
-                for _ in 0..s.steps {
-                    let r = nn::step(&state_m, &bank, &self.weights, s.completeness);
+                for k in 0..s.steps {
+                    // Diversity: each level's first match draws among the few nearest patches
+                    // (see `Settings::sample_choices`); the level's later steps are plain
+                    // nearest neighbours, which pull the draw back into a coherent motion.
+                    let sample = (k == 0).then_some(nn::Sampling { choices: s.sample_choices, seed });
+                    let r = nn::step(&state_m, &bank, &self.weights, s.completeness, sample);
                     state_m = r.matched;
                     if state_p.width > 0 {
                         state_p = r.payload;
