@@ -476,17 +476,11 @@ impl<'a> Plan<'a> {
     fn project(&self, state_m: &mut Channels, state_p: &mut Channels, len: usize, known: &[f32]) {
         // Only resample the source when something reads it (it is as wide as the synthesis).
         let world = !self.world.is_empty();
-        let resized = |c: &Channels, mask: &[bool], rotations: bool| {
-            if mask.iter().any(|&b| b) || (world && rotations) {
-                c.resize(len)
-            } else {
-                Channels::zeros(0, c.width)
-            }
-        };
+        let needed = |mask: &[bool], rotations: bool| mask.iter().any(|&b| b) || (world && rotations);
         let points = state_p.width > 0;
-        let src_m = resized(&self.source.0, &self.mask.0, !points);
-        let src_p = resized(&self.source.1, &self.mask.1, points);
-        for (state, src, mask) in [(&mut *state_m, &src_m, &self.mask.0), (&mut *state_p, &src_p, &self.mask.1)] {
+        let src_m = source_at(&self.source.0, needed(&self.mask.0, !points), len);
+        let src_p = source_at(&self.source.1, needed(&self.mask.1, points), len);
+        for (state, src, mask) in [(&mut *state_m, &*src_m, &self.mask.0), (&mut *state_p, &*src_p, &self.mask.1)] {
             let bound: Vec<usize> = (0..mask.len()).filter(|&c| mask[c]).collect();
             if bound.is_empty() {
                 continue;
@@ -502,7 +496,7 @@ impl<'a> Plan<'a> {
             }
         }
         if !self.world.is_empty() {
-            let (state, src) = if state_p.width > 0 { (state_p, &src_p) } else { (state_m, &src_m) };
+            let (state, src) = if state_p.width > 0 { (state_p, &*src_p) } else { (state_m, &*src_m) };
             self.project_world(state, src, known);
         }
     }
@@ -583,6 +577,19 @@ fn check_inputs(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion]
         }
     }
     Ok(())
+}
+
+/// The source channels at `len` frames when `needed` (else an empty stand-in). At the source's
+/// own length they are borrowed: on long clips a copy is as big as the synthesis and would
+/// raise the peak memory.
+fn source_at(c: &Channels, needed: bool, len: usize) -> std::borrow::Cow<'_, Channels> {
+    if !needed {
+        std::borrow::Cow::Owned(Channels::zeros(0, c.width))
+    } else if c.frames == len {
+        std::borrow::Cow::Borrowed(c)
+    } else {
+        std::borrow::Cow::Owned(c.resize(len))
+    }
 }
 
 /// Only the root's translations of a motion, as a one-joint motion.
