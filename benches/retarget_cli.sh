@@ -66,17 +66,17 @@ measure() {
     echo "| $label | $w | $m | $l |"
 }
 
-ours() { "$BIN" "$@" --bind "$BIND" --alpha 0.9 --seed 0 --report -o "$TMP/out.bvh"; }
+OURS=("$BIN" --bind "$BIND" --alpha 0.9 --seed 0 --report -o "$TMP/out.bvh")
 echo "load average: $(cut -d' ' -f1-3 /proc/loadavg), cores: $(nproc), runs: $RUNS (medians)"
 echo
 echo "| run | wall s | peak RSS MiB | retarget loop ms |"
 echo "|---|---|---|---|"
-measure "ours, demo (79 frames), all threads" ours "$SRC" "$EX"
-measure "ours, demo, --threads 1" ours "$SRC" "$EX" --threads 1
+measure "ours, demo (79 frames), all threads" "${OURS[@]}" "$SRC" "$EX"
+measure "ours, demo, --threads 1" "${OURS[@]}" "$SRC" "$EX" --threads 1
 if [ -n "${M2M_REF:-}" ] && [ -n "${M2M_PY:-}" ] && [ -e "$M2M_REF/run_M2M.py" ]; then
-    ref() { (cd "$M2M_REF" && "$M2M_PY" run_M2M.py -e ./data/processed/Monkey/__Walk.bvh -d cpu --source ./data/processed/Flamingo/Flamingo_Walk.bvh --mapping_file configs/mappings_flamingo.json --output_dir "$TMP/ref" --sparse_retargeting --matching_alpha 0.9 -s 0); }
-    measure "reference, demo, as shipped" ref
-    measure "reference, demo, OMP_NUM_THREADS=1" env OMP_NUM_THREADS=1 bash -c "cd '$M2M_REF' && '$M2M_PY' run_M2M.py -e ./data/processed/Monkey/__Walk.bvh -d cpu --source ./data/processed/Flamingo/Flamingo_Walk.bvh --mapping_file configs/mappings_flamingo.json --output_dir '$TMP/ref' --sparse_retargeting --matching_alpha 0.9 -s 0"
+    REF="cd '$M2M_REF' && '$M2M_PY' run_M2M.py -e ./data/processed/Monkey/__Walk.bvh -d cpu --source ./data/processed/Flamingo/Flamingo_Walk.bvh --mapping_file configs/mappings_flamingo.json --output_dir '$TMP/ref' --sparse_retargeting --matching_alpha 0.9 -s 0"
+    measure "reference, demo, as shipped" bash -c "$REF"
+    measure "reference, demo, OMP_NUM_THREADS=1" env OMP_NUM_THREADS=1 bash -c "$REF"
 else
     echo "| reference | skipped: set M2M_REF and M2M_PY | | |"
 fi
@@ -85,10 +85,10 @@ echo "Source length (one 61-frame example clip):"
 echo
 echo "| source frames | wall s | peak RSS MiB | retarget loop ms |"
 echo "|---|---|---|---|"
-for k in 1 8 32 64; do measure "$((79 * k))" ours "$TMP/src_x$k.bvh" "$EX"; done
+for k in 1 8 32 64; do measure "$((79 * k))" "${OURS[@]}" "$TMP/src_x$k.bvh" "$EX"; done
 echo
 echo "Example clips (79-frame source; copies of the 61-frame clip):"
 echo
 echo "| example clips (frames) | wall s | peak RSS MiB | retarget loop ms |"
 echo "|---|---|---|---|"
-for n in 1 4 16; do measure "$n ($((61 * n)))" ours "$SRC" "$TMP/ex$n"; done
+for n in 1 4 16; do measure "$n ($((61 * n)))" "${OURS[@]}" "$SRC" "$TMP/ex$n"; done
