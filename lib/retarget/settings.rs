@@ -7,7 +7,7 @@ use super::RetargetError;
 ///
 /// The default stays the reference's `Local`: measured with `mo-metrics transfer` on
 /// Flamingo <-> Monkey (reference and auto bindings) and three synthetic pairs
-/// (docs/retarget-results.md), `Aligned` scores within 0.002 of `Local` everywhere (the bound
+/// (docs/retarget-results.md), `Aligned` is within 0.002 (frequency alignment) / 0.01 (contacts) of `Local` (the bound
 /// channels end up blended example data, so the conversion barely shows) and `World` wins one
 /// pair (spider -> crab, frequency alignment 0.83 vs 0.05) but loses clearly on three
 /// (Flamingo -> Monkey auto 0.79 vs 0.93, Monkey -> Flamingo 0.89 vs 0.92, quadruped -> dragon
