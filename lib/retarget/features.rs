@@ -202,13 +202,15 @@ pub(crate) fn decode(rot: &Channels, skeleton: &Skeleton, scale: f64, start: (f6
         let (joint, dim) = if c < 6 * j { (c / 6, c % 6) } else { (0, c - 6 * j + 6) };
         return Err(m2m::M2mError::NonFinite { frame, joint, name: skeleton.joints[joint].name.clone(), dim, value: rot.data[k] });
     }
-    let rotations: Vec<DQuat> = (0..rot.frames)
-        .into_par_iter()
-        .flat_map_iter(|f| {
-            let row = rot.row(f);
-            (0..j).map(move |k| quat_from_6d(&row[6 * k..6 * k + 6]))
-        })
-        .collect();
+    // Filled in place: collecting a parallel flat_map goes through per-thread pieces and
+    // needs about twice the memory at the end, which set the peak on long outputs.
+    let mut rotations = vec![DQuat::IDENTITY; rot.frames * j];
+    rotations.par_chunks_mut(j.max(1)).enumerate().for_each(|(f, out)| {
+        let row = rot.row(f);
+        for (k, q) in out.iter_mut().enumerate() {
+            *q = quat_from_6d(&row[6 * k..6 * k + 6]);
+        }
+    });
     let mut translations = Vec::with_capacity(rot.frames * j);
     let (mut x, mut z) = start;
     for f in 0..rot.frames {

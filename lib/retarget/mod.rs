@@ -440,8 +440,12 @@ impl<'a> Plan<'a> {
             let bank = nn::Bank::new(cm, cp, &self.weights, self.patch);
             let mut level = LevelReport { frames: len, example_frames: bank.frames(), example_patches: bank.len(), ..LevelReport::default() };
             if bank.len() > 0 && len >= self.patch {
-                for _ in 0..s.steps {
-                    let r = nn::step(&state_m, &bank, &self.weights, s.completeness);
+                for k in 0..s.steps {
+                    // Diversity: each level's first match draws among the few nearest patches
+                    // (see `Settings::sample_choices`); the level's later steps are plain
+                    // nearest neighbours, which pull the draw back into a coherent motion.
+                    let sample = (k == 0).then_some(nn::Sampling { choices: s.sample_choices, seed });
+                    let r = nn::step(&state_m, &bank, &self.weights, s.completeness, sample);
                     state_m = r.matched;
                     if state_p.width > 0 {
                         state_p = r.payload;
@@ -472,17 +476,11 @@ impl<'a> Plan<'a> {
     fn project(&self, state_m: &mut Channels, state_p: &mut Channels, len: usize, known: &[f32]) {
         // Only resample the source when something reads it (it is as wide as the synthesis).
         let world = !self.world.is_empty();
-        let resized = |c: &Channels, mask: &[bool], rotations: bool| {
-            if mask.iter().any(|&b| b) || (world && rotations) {
-                c.resize(len)
-            } else {
-                Channels::zeros(0, c.width)
-            }
-        };
+        let needed = |mask: &[bool], rotations: bool| mask.iter().any(|&b| b) || (world && rotations);
         let points = state_p.width > 0;
-        let src_m = resized(&self.source.0, &self.mask.0, !points);
-        let src_p = resized(&self.source.1, &self.mask.1, points);
-        for (state, src, mask) in [(&mut *state_m, &src_m, &self.mask.0), (&mut *state_p, &src_p, &self.mask.1)] {
+        let src_m = source_at(&self.source.0, needed(&self.mask.0, !points), len);
+        let src_p = source_at(&self.source.1, needed(&self.mask.1, points), len);
+        for (state, src, mask) in [(&mut *state_m, &*src_m, &self.mask.0), (&mut *state_p, &*src_p, &self.mask.1)] {
             let bound: Vec<usize> = (0..mask.len()).filter(|&c| mask[c]).collect();
             if bound.is_empty() {
                 continue;
@@ -498,7 +496,7 @@ impl<'a> Plan<'a> {
             }
         }
         if !self.world.is_empty() {
-            let (state, src) = if state_p.width > 0 { (state_p, &src_p) } else { (state_m, &src_m) };
+            let (state, src) = if state_p.width > 0 { (state_p, &*src_p) } else { (state_m, &*src_m) };
             self.project_world(state, src, known);
         }
     }
@@ -579,6 +577,19 @@ fn check_inputs(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion]
         }
     }
     Ok(())
+}
+
+/// The source channels at `len` frames when `needed` (else an empty stand-in). At the source's
+/// own length they are borrowed: on long clips a copy is as big as the synthesis and would
+/// raise the peak memory.
+fn source_at(c: &Channels, needed: bool, len: usize) -> std::borrow::Cow<'_, Channels> {
+    if !needed {
+        std::borrow::Cow::Owned(Channels::zeros(0, c.width))
+    } else if c.frames == len {
+        std::borrow::Cow::Borrowed(c)
+    } else {
+        std::borrow::Cow::Owned(c.resize(len))
+    }
 }
 
 /// Only the root's translations of a motion, as a one-joint motion.

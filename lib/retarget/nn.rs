@@ -20,6 +20,9 @@ use rayon::prelude::*;
 const BLOCK: usize = 128;
 /// Largest distance matrix kept in memory (entries); bigger ones are computed twice instead.
 const MAX_STORED: usize = 1 << 23;
+/// A patch is a candidate of a seeded draw when its normalised distance is at most this many
+/// times the nearest one's.
+const NEAR_TIE: f32 = 1.5;
 /// Lane width of the dot-product kernel; rows are zero-padded to a multiple of it.
 const LANES: usize = 8;
 
@@ -242,15 +245,25 @@ fn distances(q: &Query, bank: &Bank, i0: usize, i1: usize, out: &mut [f32], scra
     }
 }
 
+/// Seeded choice among the nearest example patches instead of the nearest one (the source of
+/// diversity between seeds; see `Settings::sample_choices`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Sampling {
+    /// Each query patch picks uniformly among its `choices` nearest example patches.
+    pub choices: usize,
+    pub seed: u64,
+}
+
 /// One matching-and-blending step: every query patch of `state` picks its nearest example
-/// patch (with GenMM's completeness normalisation when `completeness` is set), and every frame
-/// becomes the average of the chosen patches covering it.
-pub(crate) fn step(state: &Channels, bank: &Bank, weights: &[f32], completeness: Option<f32>) -> StepResult {
-    step_with_limit(state, bank, weights, completeness, MAX_STORED)
+/// patch (with GenMM's completeness normalisation when `completeness` is set), or one of its
+/// few nearest when `sample` says so, and every frame becomes the average of the chosen
+/// patches covering it.
+pub(crate) fn step(state: &Channels, bank: &Bank, weights: &[f32], completeness: Option<f32>, sample: Option<Sampling>) -> StepResult {
+    step_with_limit(state, bank, weights, completeness, sample, MAX_STORED)
 }
 
 /// `step`, keeping the distance matrix only when it has at most `max_stored` entries.
-fn step_with_limit(state: &Channels, bank: &Bank, weights: &[f32], completeness: Option<f32>, max_stored: usize) -> StepResult {
+fn step_with_limit(state: &Channels, bank: &Bank, weights: &[f32], completeness: Option<f32>, sample: Option<Sampling>, max_stored: usize) -> StepResult {
     let p = bank.patch;
     let (weighted, frame_norms) = weigh(state, weights, bank.stride);
     let q = Query { weighted, norms: window_sums(&frame_norms, p), frames: state.frames };
@@ -262,7 +275,7 @@ fn step_with_limit(state: &Channels, bank: &Bank, weights: &[f32], completeness:
         let mut d = vec![0.0f32; nq * ny];
         d.par_chunks_mut(BLOCK * ny).zip(&blocks).for_each_init(Vec::new, |scratch, (out, &(i0, i1))| distances(&q, bank, i0, i1, out, scratch));
         let norm = column_normalisers(completeness, ny, d.chunks(ny));
-        d.par_chunks(ny).map(|row| nearest(row, &norm)).collect()
+        d.par_chunks(ny).enumerate().map(|(i, row)| pick(row, &norm, i, sample)).collect()
     } else {
         // Too big to keep: one pass for the column minima, one for the nearest neighbours.
         let mins: Vec<Vec<f32>> = blocks
@@ -279,7 +292,7 @@ fn step_with_limit(state: &Channels, bank: &Bank, weights: &[f32], completeness:
             .map_init(Vec::new, |scratch, &(i0, i1)| {
                 let mut out = vec![0.0f32; (i1 - i0) * ny];
                 distances(&q, bank, i0, i1, &mut out, scratch);
-                out.chunks(ny).map(|row| nearest(row, &norm)).collect::<Vec<_>>()
+                out.chunks(ny).enumerate().map(|(r, row)| pick(row, &norm, i0 + r, sample)).collect::<Vec<_>>()
             })
             .flatten()
             .collect()
@@ -306,6 +319,35 @@ fn column_normalisers<'a>(completeness: Option<f32>, ny: usize, rows: impl Itera
         None => vec![1.0; ny],
         Some(c) => column_mins(ny, rows).into_iter().map(|m| 1.0 / (c + m)).collect(),
     }
+}
+
+/// The example patch query patch `query` takes: the nearest, or with `sample` one of the
+/// `choices` nearest drawn from a stream of the seed and the query (so the draw does not depend
+/// on how queries are split among threads).
+fn pick(row: &[f32], norm: &[f32], query: usize, sample: Option<Sampling>) -> (usize, f32) {
+    let Some(Sampling { choices, seed }) = sample.filter(|s| s.choices > 1) else {
+        return nearest(row, norm);
+    };
+    // The few smallest normalised distances by insertion: `choices` is small (a handful).
+    let mut best: Vec<(f32, usize)> = Vec::with_capacity(choices + 1);
+    for (j, (&d, &n)) in row.iter().zip(norm).enumerate() {
+        let v = d * n;
+        if best.len() < choices || v < best[best.len() - 1].0 {
+            let at = best.partition_point(|&(b, _)| b <= v);
+            best.insert(at, (v, j));
+            best.truncate(choices);
+        }
+    }
+    // Only near ties are candidates: where one example patch fits far better than the rest
+    // (e.g. the source itself is an example) it stays the choice.
+    let limit = best.first().map(|b| b.0 * NEAR_TIE).unwrap_or(0.0);
+    best.retain(|b| b.0 <= limit);
+    if best.is_empty() {
+        return nearest(row, norm);
+    }
+    let r = (super::noise::stream_seed(seed, 7, query as u64) % best.len() as u64) as usize;
+    let j = best[r].1;
+    (j, row[j])
 }
 
 /// Index of the smallest normalised distance (first one on ties) and its raw distance.
@@ -428,8 +470,8 @@ mod tests {
         let payload = clips.iter().map(|c| Channels::zeros(c.frames, 0)).collect();
         let bank = Bank::new(clips, payload, &weights, 5);
         let state = channels(300, w, |t, k| ((t * 7 + k) as f32 * 0.05).cos());
-        let stored = step_with_limit(&state, &bank, &weights, Some(0.01), usize::MAX);
-        let recomputed = step_with_limit(&state, &bank, &weights, Some(0.01), 0);
+        let stored = step_with_limit(&state, &bank, &weights, Some(0.01), None, usize::MAX);
+        let recomputed = step_with_limit(&state, &bank, &weights, Some(0.01), None, 0);
         assert_eq!(stored.matched, recomputed.matched);
         assert_eq!(stored.cost.to_bits(), recomputed.cost.to_bits());
     }
@@ -439,7 +481,7 @@ mod tests {
         let w = 5;
         let ex = channels(20, w, |t, k| (t as f32 * 0.3 + k as f32).sin());
         let bank = Bank::new(vec![ex.clone()], vec![Channels::zeros(20, 0)], &[1.0; 5], 4);
-        let r = step(&ex, &bank, &[1.0; 5], None);
+        let r = step(&ex, &bank, &[1.0; 5], None, None);
         assert!(r.cost < 1e-6, "{}", r.cost);
         for (a, b) in r.matched.data.iter().zip(&ex.data) {
             assert!((a - b).abs() < 1e-6);
