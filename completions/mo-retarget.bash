@@ -23,7 +23,7 @@ _mo__retarget() {
 
     case "${cmd}" in
         mo__retarget)
-            opts="-n -o -q -v -h -V --bind --bind-rate --emit-binding --samples --frames --seconds --key-frames --format --patch --alpha --steps --pyramid --repr --bound-rotation --root-motion --report --output --seed --quiet --verbose --threads --help --version"
+            opts="-n -o -q -v -h -V --bind --bind-rate --emit-binding --samples --frames --seconds --key-frames --format --patch --alpha --steps --pyramid --repr --bound-rotation --root-motion --copy-bound --report --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

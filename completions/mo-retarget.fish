@@ -22,6 +22,7 @@ complete -c mo-retarget -s o -l output -d 'Write output here instead of stdout (
 complete -c mo-retarget -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-retarget -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
 complete -c mo-retarget -l emit-binding -d 'Print the binding (JSON) and stop'
+complete -c mo-retarget -l copy-bound -d 'After synthesis, overwrite the bound channels with the source\'s (the paper\'s "directly copy", the reference\'s copy mode): bound joints follow the source exactly'
 complete -c mo-retarget -l report -d 'Print timing, binding, pyramid levels and per-level match cost on stderr'
 complete -c mo-retarget -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-retarget -s v -l verbose -d 'Print more about what is happening on stderr'

@@ -25,7 +25,7 @@ fn every_help_ends_with_examples_that_run() {
             assert!(line.starts_with(&name) || line.contains(&format!("| {name}")), "{name}: example does not use the tool: {line}");
             let out = Command::new("bash").arg("-o").arg("pipefail").arg("-c").arg(line).current_dir(&work).env("PATH", &path).output().unwrap();
             assert!(out.status.success(), "{name} example failed: {line}\nstderr: {}", String::from_utf8_lossy(&out.stderr));
-            let writes_file = [" -o ", ">", " --sheet ", " --gif ", " --html "].iter().any(|w| line.contains(w));
+            let writes_file = [" -o ", ">", " --sheet ", " --gif ", " --html ", " --out ", " --bvh "].iter().any(|w| line.contains(w));
             assert!(!out.stdout.is_empty() || writes_file, "{name} example printed nothing: {line}");
             ran += 1;
         }

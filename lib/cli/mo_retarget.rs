@@ -103,6 +103,10 @@ pub struct Args {
     /// Where the root trajectory comes from.
     #[arg(long, value_enum)]
     pub root_motion: Option<RootArg>,
+    /// After synthesis, overwrite the bound channels with the source's (the paper's "directly
+    /// copy", the reference's copy mode): bound joints follow the source exactly.
+    #[arg(long)]
+    pub copy_bound: bool,
     /// Print timing, binding, pyramid levels and per-level match cost on stderr.
     #[arg(long)]
     pub report: bool,
@@ -182,7 +186,7 @@ fn canonical_rest(c: &Clip) -> anyhow::Result<Vec<glam::DVec3>> {
 }
 
 fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Settings> {
-    let mut s = Settings { seed: args.common.seed, ..Settings::default() };
+    let mut s = Settings { seed: args.common.seed, copy_bound: args.copy_bound, ..Settings::default() };
     if let Some(p) = args.patch {
         if p < 1 {
             bail!("--patch must be at least 1 frame");

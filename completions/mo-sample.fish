@@ -1,0 +1,15 @@
+complete -c mo-sample -l model -d 'Model directory written by mo-train' -r -F
+complete -c mo-sample -s n -l samples -d 'Number of samples' -r
+complete -c mo-sample -l frames -d 'Frames per sample' -r
+complete -c mo-sample -l seconds -d 'Length in seconds (at the skeleton\'s frame rate)' -r
+complete -c mo-sample -l steps -d 'Diffusion steps to visit (1..=100)' -r
+complete -c mo-sample -l sampler -d 'Sampler' -r -f -a "ddpm\t''
+ddim\t''"
+complete -c mo-sample -l bvh -d 'Write BVH files instead of NPY (\'{i}\' becomes the sample index)' -r -F
+complete -c mo-sample -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
+complete -c mo-sample -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
+complete -c mo-sample -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-sample -s q -l quiet -d 'Print nothing on stderr but errors'
+complete -c mo-sample -s v -l verbose -d 'Print more about what is happening on stderr'
+complete -c mo-sample -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mo-sample -s V -l version -d 'Print version'

@@ -1,0 +1,17 @@
+complete -c mo-train -l out -d 'Model directory to write (and to resume from)' -r -F
+complete -c mo-train -l preset -d 'Model size: tiny, small or paper (width 128, 4 layers, 4 heads)' -r -f -a "tiny\t''
+small\t''
+paper\t''"
+complete -c mo-train -l steps -d 'Training steps in total (a resumed run counts the steps already done)' -r
+complete -c mo-train -l batch -d 'Crops per step' -r
+complete -c mo-train -l crop -d 'Crop length in frames' -r
+complete -c mo-train -l lr -d 'Learning rate' -r
+complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this often' -r
+complete -c mo-train -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
+complete -c mo-train -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
+complete -c mo-train -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-train -l resume -d 'Continue from the checkpoint in --out'
+complete -c mo-train -s q -l quiet -d 'Print nothing on stderr but errors'
+complete -c mo-train -s v -l verbose -d 'Print more about what is happening on stderr'
+complete -c mo-train -s h -l help -d 'Print help (see more with \'--help\')'
+complete -c mo-train -s V -l version -d 'Print version'
