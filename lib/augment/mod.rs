@@ -120,8 +120,7 @@ impl Plan {
     }
 }
 
-/// Uniform integer in `0..n` (`n` > 0), by the multiply-shift method (bias below 2^-32 for
-/// any realistic `n`).
+/// Uniform integer in `0..n` (`SplitMix64::below`).
 pub(crate) fn below(rng: &mut SplitMix64, n: usize) -> usize {
-    ((rng.next_u64() as u128 * n as u128) >> 64) as usize
+    rng.below(n)
 }

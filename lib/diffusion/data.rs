@@ -130,12 +130,12 @@ impl TrainSet {
     pub fn sample(&self, rng: &mut SplitMix64, batch: usize, frames: usize) -> Vec<Crop> {
         (0..batch)
             .map(|_| {
-                let s = below(rng, self.skeletons.len());
+                let s = rng.below(self.skeletons.len());
                 let sk = &self.skeletons[s];
-                let c = below(rng, sk.clips.len());
+                let c = rng.below(sk.clips.len());
                 let clip = &sk.clips[c];
                 let len = clip.frames.min(frames);
-                let start = below(rng, clip.frames - len + 1);
+                let start = rng.below(clip.frames - len + 1);
                 Crop { skeleton: s, clip: c, start, frames: len }
             })
             .collect()
@@ -158,10 +158,6 @@ pub struct Crop {
     pub frames: usize,
 }
 
-/// Uniform integer in [0, n), n ≥ 1.
-fn below(rng: &mut SplitMix64, n: usize) -> usize {
-    ((rng.next_u64() as u128 * n.max(1) as u128) >> 64) as usize
-}
 
 #[cfg(test)]
 mod tests {

@@ -134,7 +134,7 @@ pub fn train_step(
             BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 }
         })
         .collect();
-    let steps: Vec<u32> = (0..batch).map(|_| ((rng.next_u64() as u128 * schedule.len() as u128) >> 64) as u32).collect();
+    let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
     let clean = batch_from(&items, &steps, device)?;
     let (b, t, j, d) = clean.dims()?;
     let noise = Tensor::from_vec(gaussian(rng, b * t * j * d), (b, t, j, d), device)?;

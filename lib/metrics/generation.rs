@@ -356,10 +356,6 @@ pub fn aggregate(reports: &[GenerationReport]) -> GenerationAggregate {
     }
 }
 
-/// Uniform integer in [0, n) (n ≥ 1), by the multiply-shift rule (bias ≤ n / 2⁶⁴).
-fn below(rng: &mut SplitMix64, n: usize) -> usize {
-    ((rng.next_u64() as u128 * n as u128) >> 64) as usize
-}
 
 /// AnyTop's generation metrics of `generated` samples against `gt` clips of one skeleton.
 ///
@@ -438,15 +434,15 @@ pub fn generation_metrics(
     let mut rng = SplitMix64::new(opts.seed);
     let gt_offsets: Vec<Vec<(usize, usize)>> = kept
         .iter()
-        .map(|c| (0..opts.gt_pairs).map(|_| (below(&mut rng, c.frames - w), below(&mut rng, c.frames - w))).collect())
+        .map(|c| (0..opts.gt_pairs).map(|_| (rng.below(c.frames - w), rng.below(c.frames - w))).collect())
         .collect();
     let gen_offsets: Vec<(usize, usize)> =
-        generated.iter().map(|c| (below(&mut rng, c.frames - w), below(&mut rng, c.frames - w))).collect();
+        generated.iter().map(|c| (rng.below(c.frames - w), rng.below(c.frames - w))).collect();
     let subsets: Vec<Vec<usize>> = (0..opts.reps)
         .map(|_| {
             let mut idx: Vec<usize> = (0..generated.len()).collect();
             for i in 0..subset {
-                let j = i + below(&mut rng, idx.len() - i);
+                let j = i + rng.below(idx.len() - i);
                 idx.swap(i, j);
             }
             idx.truncate(subset);

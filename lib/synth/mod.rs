@@ -128,6 +128,12 @@ impl SplitMix64 {
         z ^ (z >> 31)
     }
 
+    /// Uniform integer in `0..n` (0 when `n` is 0), by the multiply-shift method (bias below
+    /// 2^-32 for any realistic `n`).
+    pub fn below(&mut self, n: usize) -> usize {
+        ((self.next_u64() as u128 * n as u128) >> 64) as usize
+    }
+
     /// Uniform in [0, 1).
     pub fn unit(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
