@@ -6,6 +6,7 @@ complete -c mo-train -l steps -d 'Training steps in total (a resumed run counts 
 complete -c mo-train -l batch -d 'Crops per step' -r
 complete -c mo-train -l crop -d 'Crop length in frames' -r
 complete -c mo-train -l lr -d 'Learning rate' -r
+complete -c mo-train -l lambda-geo -d 'Weight of the rotation loss (1 - cos of the angle between predicted and true joint rotations) next to the MSE; the reference trains with 1' -r
 complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this often' -r
 complete -c mo-train -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-train -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r

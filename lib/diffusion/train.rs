@@ -112,7 +112,9 @@ pub struct StepStats {
 }
 
 /// One training step: draw a batch of crops and timesteps, noise the motion (never the rest
-/// token), predict x0, masked MSE, backward, AdamW.
+/// token), predict x0; loss = masked MSE (normalised space) + `lambda_geo` × the rotation
+/// distance of the 6D rotations (physical space), both over real joints and frames, as the
+/// reference (§3.3, λ_geo = 1 in its training commands); backward, AdamW.
 pub fn train_step(
     model: &Denoiser,
     vars: &BTreeMap<String, Var>,
@@ -122,6 +124,7 @@ pub fn train_step(
     rng: &mut SplitMix64,
     batch: usize,
     crop: usize,
+    lambda_geo: f64,
     device: &Device,
 ) -> anyhow::Result<StepStats> {
     let crops = set.sample(rng, batch, crop);
@@ -150,12 +153,57 @@ pub fn train_step(
     let predicted = model.forward(&input)?;
     // Real motion tokens only: frames 1.. that exist, joints that exist.
     let mask = clean.frame_mask.reshape((b, t, 1, 1))?.broadcast_mul(&clean.joint_mask.reshape((b, 1, j, 1))?)?.broadcast_mul(&motion_token)?;
-    let err = ((predicted - &clean.x)?.sqr()?.broadcast_mul(&mask))?;
+    let err = ((&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask))?;
     let count = (mask.sum_all()?.to_scalar::<f32>()? as f64 * d as f64).max(1.0);
-    let loss = (err.sum_all()? / count)?;
+    let mse = (err.sum_all()? / count)?;
+    // The rotation term needs the 6D values in physical units: undo each skeleton's
+    // normalisation (padded joints get mean 0, std 1; they are masked anyway).
+    let (mut mean, mut std) = (vec![0f32; b * j * 6], vec![1f32; b * j * 6]);
+    for (i, c) in crops.iter().enumerate() {
+        let stats = &set.skeletons[c.skeleton].stats;
+        for jj in 0..set.skeletons[c.skeleton].skeleton.len() {
+            for k in 0..6 {
+                mean[(i * j + jj) * 6 + k] = stats.mean[jj * d + 3 + k];
+                std[(i * j + jj) * 6 + k] = stats.std[jj * d + 3 + k] + crate::repr::anytop::STD_EPSILON;
+            }
+        }
+    }
+    let mean = Tensor::from_vec(mean, (b, 1, j, 6), device)?;
+    let std = Tensor::from_vec(std, (b, 1, j, 6), device)?;
+    let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(3, 3, 6)?.broadcast_mul(&std)?.broadcast_add(&mean) };
+    let geo = rotation_distance(&physical(&predicted)?, &physical(&clean.x)?)?;
+    let tokens = mask.sum_all()?.to_scalar::<f32>()?.max(1.0) as f64;
+    let geo = (geo.unsqueeze(3)?.broadcast_mul(&mask)?.sum_all()? / tokens)?;
+    let loss = (&mse + (geo * lambda_geo)?)?;
     let grads = loss.backward()?;
     opt.update(vars, &grads)?;
     Ok(StepStats { loss: loss.to_scalar::<f32>()? as f64 })
+}
+
+/// 1 − cos θ of the rotation between two 6D rotations (first two matrix columns, `[..., 6]`),
+/// per token: (3 − tr(R̂ᵀR)) / 2. The reference takes θ itself (arccos); candle has no arccos,
+/// and 1 − cos θ is a smooth, monotone function of θ (≈ θ²/2 for small angles) with the same
+/// minimiser, whose gradient does not blow up at θ = 0 as arccos's does.
+pub fn rotation_distance(a: &Tensor, b: &Tensor) -> candle_core::Result<Tensor> {
+    let frame = |x: &Tensor| -> candle_core::Result<[Tensor; 3]> {
+        let last = x.rank() - 1;
+        let norm = |v: &Tensor| -> candle_core::Result<Tensor> { v.broadcast_div(&(v.sqr()?.sum_keepdim(last)? + 1e-8)?.sqrt()?) };
+        let c1 = norm(&x.narrow(last, 0, 3)?)?;
+        let a2 = x.narrow(last, 3, 3)?;
+        let c2 = norm(&(&a2 - c1.broadcast_mul(&(&c1 * &a2)?.sum_keepdim(last)?)?)?)?;
+        let comp = |v: &Tensor, k: usize| v.narrow(last, k, 1);
+        let (x1, y1, z1) = (comp(&c1, 0)?, comp(&c1, 1)?, comp(&c1, 2)?);
+        let (x2, y2, z2) = (comp(&c2, 0)?, comp(&c2, 1)?, comp(&c2, 2)?);
+        let c3 = Tensor::cat(&[((&y1 * &z2)? - (&z1 * &y2)?)?, ((&z1 * &x2)? - (&x1 * &z2)?)?, ((&x1 * &y2)? - (&y1 * &x2)?)?], last)?;
+        Ok([c1, c2, c3])
+    };
+    let (fa, fb) = (frame(a)?, frame(b)?);
+    let last = a.rank() - 1;
+    let mut trace = (&fa[0] * &fb[0])?.sum(last)?;
+    for k in 1..3 {
+        trace = (trace + (&fa[k] * &fb[k])?.sum(last)?)?;
+    }
+    (trace * -0.5)? + 1.5
 }
 
 #[cfg(test)]
@@ -201,7 +249,7 @@ mod tests {
                 opt.load_state(&state, step);
                 let _ = std::fs::remove_dir_all(&dir);
             }
-            losses.push(train_step(&model, &vars, &mut opt, set, &schedule, &mut rng, 2, 12, &dev).unwrap().loss);
+            losses.push(train_step(&model, &vars, &mut opt, set, &schedule, &mut rng, 2, 12, 1.0, &dev).unwrap().loss);
         }
         losses
     }
@@ -213,6 +261,18 @@ mod tests {
         assert!(a.iter().all(|l| l.is_finite() && *l > 0.0), "{a:?}");
         assert_eq!(a, run(&set, 4, None), "same seed, same losses");
         assert_eq!(a, run(&set, 4, Some(2)), "a resumed run continues the same run");
+    }
+
+    #[test]
+    fn rotation_distance_is_zero_for_equal_rotations_and_grows_with_angle() {
+        let dev = Device::Cpu;
+        // Identity (columns x, y) and rotations by 90 and 180 degrees about z; 6D are unnormalised.
+        let r = |c1: [f32; 3], c2: [f32; 3]| Tensor::from_vec([c1, c2].concat(), (1, 6), &dev).unwrap();
+        let id = r([2.0, 0.0, 0.0], [0.3, 1.0, 0.0]);
+        let d = |a: &Tensor, b: &Tensor| rotation_distance(a, b).unwrap().to_vec1::<f32>().unwrap()[0];
+        assert!(d(&id, &id).abs() < 1e-6);
+        assert!((d(&id, &r([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])) - 1.0).abs() < 1e-5, "90 degrees: 1 - cos = 1");
+        assert!((d(&id, &r([-1.0, 0.0, 0.0], [0.0, -1.0, 0.0])) - 2.0).abs() < 1e-5, "180 degrees: 2");
     }
 
     #[test]
