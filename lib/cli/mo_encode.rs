@@ -287,16 +287,7 @@ fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<Clip> {
 
 /// AnyTop encodes one skeleton per call: same joint names and parents.
 fn check_same_skeleton(a_name: &str, a: &Skeleton, b_name: &str, b: &Skeleton) -> anyhow::Result<()> {
-    let same = a.len() == b.len() && a.joints.iter().zip(&b.joints).all(|(x, y)| x.name == y.name && x.parent == y.parent);
-    if !same {
-        let why = match a.joints.iter().zip(&b.joints).position(|(x, y)| x.name != y.name || x.parent != y.parent) {
-            Some(j) if a.joints[j].name == b.joints[j].name => format!(
-                "joint {j} '{}' hangs from joint {:?} in one and {:?} in the other",
-                a.joints[j].name, a.joints[j].parent, b.joints[j].parent
-            ),
-            Some(j) => format!("joint {j} is '{}' in one and '{}' in the other", a.joints[j].name, b.joints[j].name),
-            None => format!("{} joints against {}", a.len(), b.len()),
-        };
+    if let Some(why) = a.first_difference(b) {
         bail!("{a_name} and {b_name} have different skeletons ({why}): AnyTop encodes one skeleton per call, so encode them separately");
     }
     Ok(())
@@ -349,7 +340,7 @@ fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
             if let Some(w) = warning {
                 eprintln!("mo-encode: warning: {}: {w}", clip.name);
             }
-            if clip.skeleton.joints.iter().zip(&first.skeleton.joints).any(|(a, b)| a.name != b.name || a.parent != b.parent) {
+            if first.skeleton.first_difference(&clip.skeleton).is_some() {
                 eprintln!("mo-encode: warning: {} and {} have the same shape but different joint names or parents", first.name, clip.name);
             }
         }

@@ -6,7 +6,6 @@
 use crate::cli::load::{expand_inputs, is_dash, load_motions, DecodeFrom, LoadOptions, Loaded};
 use crate::cli::CommonOpts;
 use crate::io;
-use crate::motion::Motion;
 use crate::render::camera::Framing;
 use crate::render::gif::{render_gif, GifOptions};
 use crate::render::html::{render_html, HtmlOptions};
@@ -207,17 +206,6 @@ fn kind_of_extension(p: &Path) -> Option<Kind> {
     }
 }
 
-/// Frames `range` of a motion, as its own motion.
-fn slice_frames(motion: &Motion, start: usize, end: usize) -> Motion {
-    let j = motion.joints;
-    Motion {
-        frames: end - start,
-        joints: j,
-        frame_time: motion.frame_time,
-        rotations: motion.rotations[start * j..end * j].to_vec(),
-        translations: motion.translations[start * j..end * j].to_vec(),
-    }
-}
 
 /// The first drawn frame and the tracks.
 fn tracks(loaded: &[Loaded], range: Option<(Option<usize>, Option<usize>)>) -> anyhow::Result<(usize, Vec<Track>)> {
@@ -232,7 +220,7 @@ fn tracks(loaded: &[Loaded], range: Option<(Option<usize>, Option<usize>)>) -> a
         if start >= end {
             bail!("{}: --frames starts at frame {start} but the motion has {frames} frames (0..{})", l.name, frames - 1);
         }
-        let motion = if start == 0 && end == frames { l.motion.clone() } else { slice_frames(&l.motion, start, end) };
+        let motion = if start == 0 && end == frames { l.motion.clone() } else { l.motion.frame_range(start, end) };
         let title = Path::new(&l.name).file_name().map_or(l.name.clone(), |f| f.to_string_lossy().into_owned());
         out.push(Track::from_motion(&title, &l.skeleton, &motion));
     }

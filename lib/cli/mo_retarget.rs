@@ -167,15 +167,10 @@ fn read_clip(path: &Path) -> anyhow::Result<Clip> {
 
 /// Same tree and names (the examples must be clips of one skeleton).
 fn same_skeleton(a: &Clip, b: &Clip) -> anyhow::Result<()> {
-    if a.skeleton.len() != b.skeleton.len() {
-        bail!("{} has {} joints but {} has {}: all target clips must share one skeleton", b.name, b.skeleton.len(), a.name, a.skeleton.len());
+    match a.skeleton.first_difference(&b.skeleton) {
+        Some(why) => bail!("{} and {} have different skeletons ({why}): all target clips must share one skeleton", a.name, b.name),
+        None => Ok(()),
     }
-    for (j, (x, y)) in a.skeleton.joints.iter().zip(&b.skeleton.joints).enumerate() {
-        if x.parent != y.parent || x.name != y.name {
-            bail!("{}: joint {j} is '{}' but {} has '{}' there: all target clips must share one skeleton", b.name, y.name, a.name, x.name);
-        }
-    }
-    Ok(())
 }
 
 /// The AnyTop rig's natural rest pose: faces +z, so two creatures compare in one frame.

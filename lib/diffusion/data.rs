@@ -58,9 +58,6 @@ pub enum DataError {
     TooShort { clip: String },
 }
 
-fn same_skeleton(a: &Skeleton, b: &Skeleton) -> bool {
-    a.len() == b.len() && a.joints.iter().zip(&b.joints).all(|(x, y)| x.name == y.name && x.parent == y.parent)
-}
 
 impl TrainSet {
     /// Group `clips` by skeleton and prepare them. Clips too short to crop are dropped
@@ -71,7 +68,7 @@ impl TrainSet {
         }
         let mut groups: Vec<Vec<RawClip>> = Vec::new();
         for c in clips {
-            match groups.iter_mut().find(|g| same_skeleton(&g[0].skeleton, &c.skeleton)) {
+            match groups.iter_mut().find(|g| g[0].skeleton.first_difference(&c.skeleton).is_none()) {
                 Some(g) => g.push(c),
                 None => groups.push(vec![c]),
             }

@@ -78,14 +78,20 @@ impl Motion {
 
     /// The first `n` frames (all of them when there are fewer).
     pub fn first_frames(&self, n: usize) -> Motion {
-        let n = n.min(self.frames);
-        let k = n * self.joints;
+        self.frame_range(0, n)
+    }
+
+    /// Frames `start..end` as their own motion (clamped to the frames there are).
+    pub fn frame_range(&self, start: usize, end: usize) -> Motion {
+        let end = end.min(self.frames);
+        let start = start.min(end);
+        let j = self.joints;
         Motion {
-            frames: n,
-            joints: self.joints,
+            frames: end - start,
+            joints: j,
             frame_time: self.frame_time,
-            rotations: self.rotations[..k].to_vec(),
-            translations: self.translations[..k].to_vec(),
+            rotations: self.rotations[start * j..end * j].to_vec(),
+            translations: self.translations[start * j..end * j].to_vec(),
         }
     }
 

@@ -98,6 +98,20 @@ impl Skeleton {
         }
     }
 
+    /// Where `other` stops being the same skeleton as this one (same joint names and parents,
+    /// in the same order), said for a message; `None` when they are the same.
+    pub fn first_difference(&self, other: &Skeleton) -> Option<String> {
+        match self.joints.iter().zip(&other.joints).position(|(x, y)| x.name != y.name || x.parent != y.parent) {
+            Some(j) if self.joints[j].name == other.joints[j].name => Some(format!(
+                "joint {j} '{}' hangs from joint {:?} in one and {:?} in the other",
+                self.joints[j].name, self.joints[j].parent, other.joints[j].parent
+            )),
+            Some(j) => Some(format!("joint {j} is '{}' in one and '{}' in the other", self.joints[j].name, other.joints[j].name)),
+            None if self.len() != other.len() => Some(format!("{} joints against {}", self.len(), other.len())),
+            None => None,
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.joints.len()
     }
