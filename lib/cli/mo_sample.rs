@@ -73,6 +73,7 @@ pub enum SamplerArg {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
+    crate::nn::keep_freed_memory();
     let Some(model_dir) = &args.model else {
         bail!("--model DIR is needed: no default model ships yet (train one with mo-train)");
     };

@@ -93,6 +93,7 @@ impl Preset {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
+    crate::nn::keep_freed_memory();
     if !(args.lr.is_finite() && args.lr > 0.0) {
         bail!("--lr must be a positive number, found {}", args.lr);
     }

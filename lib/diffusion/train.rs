@@ -7,7 +7,7 @@
 //! Noise and timesteps come from our seeded SplitMix64, so the same seed and data give the
 //! same run whatever the thread count.
 
-use super::data::TrainSet;
+use super::data::{Crop, TrainSet};
 use super::schedule::Schedule;
 use crate::nn::{batch_from, BatchItem, Denoiser};
 use crate::synth::SplitMix64;
@@ -115,6 +115,11 @@ pub struct StepStats {
 /// token), predict x0; loss = masked MSE (normalised space) + `lambda_geo` × the rotation
 /// distance of the 6D rotations (physical space), both over real joints and frames, as the
 /// reference (§3.3, λ_geo = 1 in its training commands); backward, AdamW.
+///
+/// The crops of each skeleton go through the model as their own sub-batch: padding every crop
+/// to the batch's largest skeleton (88 joints for the centipede next to 14 for the fish) would
+/// spend most of the attention work on padding. The model gives a clip the same output alone
+/// or padded (nn tests), so this changes the cost, not the loss.
 pub fn train_step(
     model: &Denoiser,
     vars: &BTreeMap<String, Var>,
@@ -128,6 +133,43 @@ pub fn train_step(
     device: &Device,
 ) -> anyhow::Result<StepStats> {
     let crops = set.sample(rng, batch, crop);
+    let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
+    let mut order: Vec<usize> = Vec::new();
+    for c in &crops {
+        if !order.contains(&c.skeleton) {
+            order.push(c.skeleton);
+        }
+    }
+    let mut total: Option<LossSums> = None;
+    for skeleton in order {
+        let chosen: Vec<usize> = (0..crops.len()).filter(|&i| crops[i].skeleton == skeleton).collect();
+        let part_crops: Vec<Crop> = chosen.iter().map(|&i| crops[i]).collect();
+        let part_steps: Vec<u32> = chosen.iter().map(|&i| steps[i]).collect();
+        let part = loss_sums(model, set, schedule, &part_crops, &part_steps, rng, device)?;
+        total = Some(match total {
+            None => part,
+            Some(t) => LossSums { squared: (t.squared + part.squared)?, values: t.values + part.values, rotation: (t.rotation + part.rotation)?, tokens: t.tokens + part.tokens },
+        });
+    }
+    let Some(sums) = total else { anyhow::bail!("an empty training batch") };
+    let mse = (sums.squared / sums.values.max(1.0))?;
+    let geo = (sums.rotation / sums.tokens.max(1.0))?;
+    let loss = (&mse + (geo * lambda_geo)?)?;
+    let grads = loss.backward()?;
+    opt.update(vars, &grads)?;
+    Ok(StepStats { loss: loss.to_scalar::<f32>()? as f64 })
+}
+
+/// Unnormalised loss terms of one sub-batch: summed squared error and the number of values it
+/// covers, summed rotation distance and the number of tokens.
+struct LossSums {
+    squared: Tensor,
+    values: f64,
+    rotation: Tensor,
+    tokens: f64,
+}
+
+fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, device: &Device) -> anyhow::Result<LossSums> {
     let features: Vec<_> = crops.iter().map(|c| set.crop(c)).collect();
     let items: Vec<BatchItem> = crops
         .iter()
@@ -137,8 +179,7 @@ pub fn train_step(
             BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 }
         })
         .collect();
-    let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
-    let clean = batch_from(&items, &steps, device)?;
+    let clean = batch_from(&items, steps, device)?;
     let (b, t, j, d) = clean.dims()?;
     let noise = Tensor::from_vec(gaussian(rng, b * t * j * d), (b, t, j, d), device)?;
     let (a, s): (Vec<f32>, Vec<f32>) = steps.iter().map(|&k| schedule.noise_coefficients(k as usize)).map(|(a, s)| (a as f32, s as f32)).unzip();
@@ -153,9 +194,8 @@ pub fn train_step(
     let predicted = model.forward(&input)?;
     // Real motion tokens only: frames 1.. that exist, joints that exist.
     let mask = clean.frame_mask.reshape((b, t, 1, 1))?.broadcast_mul(&clean.joint_mask.reshape((b, 1, j, 1))?)?.broadcast_mul(&motion_token)?;
-    let err = ((&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask))?;
-    let count = (mask.sum_all()?.to_scalar::<f32>()? as f64 * d as f64).max(1.0);
-    let mse = (err.sum_all()? / count)?;
+    let squared = (&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask)?.sum_all()?;
+    let tokens = mask.sum_all()?.to_scalar::<f32>()? as f64;
     // The rotation term needs the 6D values in physical units: undo each skeleton's
     // normalisation (padded joints get mean 0, std 1; they are masked anyway).
     let (mut mean, mut std) = (vec![0f32; b * j * 6], vec![1f32; b * j * 6]);
@@ -172,12 +212,8 @@ pub fn train_step(
     let std = Tensor::from_vec(std, (b, 1, j, 6), device)?;
     let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(3, 3, 6)?.broadcast_mul(&std)?.broadcast_add(&mean) };
     let geo = rotation_distance(&physical(&predicted)?, &physical(&clean.x)?)?;
-    let tokens = mask.sum_all()?.to_scalar::<f32>()?.max(1.0) as f64;
-    let geo = (geo.unsqueeze(3)?.broadcast_mul(&mask)?.sum_all()? / tokens)?;
-    let loss = (&mse + (geo * lambda_geo)?)?;
-    let grads = loss.backward()?;
-    opt.update(vars, &grads)?;
-    Ok(StepStats { loss: loss.to_scalar::<f32>()? as f64 })
+    let rotation = geo.unsqueeze(3)?.broadcast_mul(&mask)?.sum_all()?;
+    Ok(LossSums { squared, values: tokens * d as f64, rotation, tokens })
 }
 
 /// 1 − cos θ of the rotation between two 6D rotations (first two matrix columns, `[..., 6]`),

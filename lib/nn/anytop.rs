@@ -24,21 +24,30 @@
 //! padding nor other samples, so a padded batch gives each clip the output it gets alone.
 
 use super::config::{DenoiserConfig, RELATION_TYPES};
-use super::layers::{merge_heads, sinusoid, split_heads, window_mask, FeedForward, LayerNorm, Linear, MASKED};
+use super::fused::{self, Groups, Keys};
+use super::layers::{sinusoid, FeedForward, LayerNorm, Linear};
+use std::sync::Arc;
 use super::{Batch, NnError};
 use candle_core::{DType, Tensor, D};
 use candle_nn::{Init, VarBuilder};
 
-/// Per-forward tensors shared by all layers.
+/// Per-forward masks shared by all layers.
 struct Context {
     b: usize,
     t: usize,
     j: usize,
-    /// One-hot of (D, R) per (sample, query joint), transposed for the bias matmul, plus a
-    /// last row with the additive key-padding mask (0 or -1e9): `[B*J, dmax+1+6+1, J]`.
-    topology: Tensor,
-    /// Additive window-and-padding mask for temporal attention, `[B, 1, 1, T, T]`.
-    temporal: Tensor,
+    /// Skeletal attention: per (sample, query, key) the distance and relation type ids, and
+    /// which joints are real.
+    skeletal: Keys,
+    /// Temporal attention: the window and which tokens are real.
+    temporal: Keys,
+}
+
+/// `[rows, 3d]` queries, keys and values from one matmul against the stacked weights.
+fn project_qkv(query: &Linear, key: &Linear, value: &Linear, rows: &Tensor) -> candle_core::Result<Tensor> {
+    let w = Tensor::cat(&[query.weight(), key.weight(), value.weight()], 0)?; // [3d, d]
+    let b = Tensor::cat(&[query.bias(), key.bias(), value.bias()], 0)?;
+    fused::add_broadcast(&rows.matmul(&w.t()?)?, &b, 1)
 }
 
 #[derive(Clone, Debug)]
@@ -62,32 +71,15 @@ impl SkeletalAttention {
         })
     }
 
-    /// `x`: `[B, T, J, d]`; `eq`/`ek`: topology tables per head `[H, dh, types]`.
-    fn forward(&self, x: &Tensor, ctx: &Context, eq: &Tensor, ek: &Tensor) -> candle_core::Result<Tensor> {
-        let (b, t, j, h) = (ctx.b, ctx.t, ctx.j, self.heads);
+    /// `x`: `[B, T, J, d]`; `bias_projection`: `[3d, H * types]` (see `Denoiser::bias_projection`).
+    fn forward(&self, x: &Tensor, ctx: &Context, bias_projection: &Tensor) -> candle_core::Result<Tensor> {
+        let (b, t, j) = (ctx.b, ctx.t, ctx.j);
         let d = x.dim(D::Minus1)?;
-        let rows = x.reshape((b * t, j, d))?;
-        let q = split_heads(&self.query.forward(&rows)?, h)?; // [B*T, H, J, dh]
-        let k = split_heads(&self.key.forward(&rows)?, h)?;
-        let v = split_heads(&self.value.forward(&rows)?, h)?;
-        // The 1/sqrt(head_dim) scale is applied to the small operands (q and the topology
-        // coefficients) rather than to the J x J logits: the logits are the big tensors here
-        // and every pass over them costs (see benches/nn.rs).
-        let q = (q * (1.0 / ((d / h) as f64).sqrt()))?;
-        let types = eq.dim(D::Minus1)?;
-        // c[bt, h, i, type] = q_i·Eq[type] + k_i·Ek[type] (scaled); bias[i, j] = c[i, type(i, j)]
-        // for both the distance and the relation type, summed, as a matmul against the
-        // one-hot of (D_ij, R_ij). A last column of ones picks up the key-padding mask, which
-        // the context stores as the last one-hot row, so the mask costs no extra pass.
-        let ek_scaled = (ek * (1.0 / ((d / h) as f64).sqrt()))?;
-        let c = (q.broadcast_matmul(eq)? + k.broadcast_matmul(&ek_scaled)?)?; // [B*T, H, J, types]
-        let c = c.reshape((b, t, h, j, types))?.permute((0, 3, 1, 2, 4))?.contiguous()?.reshape((b * j, t * h, types))?;
-        let c = Tensor::cat(&[c, Tensor::ones((b * j, t * h, 1), DType::F32, x.device())?], 2)?;
-        let bias = c.matmul(&ctx.topology)?; // [B*J, T*H, J]
-        let bias = bias.reshape((b, j, t, h, j))?.permute((0, 2, 3, 1, 4))?; // [B, T, H, J(i), J(j)]
-        let logits = (q.matmul(&k.t()?)?.reshape((b, t, h, j, j))? + bias)?;
-        let p = super::layers::softmax(&logits)?.reshape((b * t, h, j, j))?;
-        let y = merge_heads(&p.matmul(&v)?)?; // [B*T, J, d]
+        let qkv = project_qkv(&self.query, &self.key, &self.value, &x.reshape((b * t * j, d))?)?;
+        // c[row, h, type] = (q_i·Eq[type] + k_i·Ek[type]) / sqrt(dh): every topology term of
+        // the logit (i, j) is c at the query's row for the pair's distance and relation type.
+        let c = qkv.matmul(bias_projection)?;
+        let y = fused::attention(&qkv, Some(&c), Groups::joints(b, t, j), self.heads, ctx.skeletal.clone())?;
         self.out.forward(&y)?.reshape((b, t, j, d))
     }
 }
@@ -113,18 +105,13 @@ impl TemporalAttention {
         })
     }
 
+    /// Tokens stay in `[B, T, J]` order: the kernel walks each joint's tokens with a stride.
     fn forward(&self, x: &Tensor, ctx: &Context) -> candle_core::Result<Tensor> {
-        let (b, t, j, h) = (ctx.b, ctx.t, ctx.j, self.heads);
+        let (b, t, j) = (ctx.b, ctx.t, ctx.j);
         let d = x.dim(D::Minus1)?;
-        let rows = x.permute((0, 2, 1, 3))?.contiguous()?.reshape((b * j, t, d))?;
-        let q = split_heads(&self.query.forward(&rows)?, h)?; // [B*J, H, T, dh]
-        let k = split_heads(&self.key.forward(&rows)?, h)?;
-        let v = split_heads(&self.value.forward(&rows)?, h)?;
-        let q = (q * (1.0 / ((d / h) as f64).sqrt()))?;
-        let logits = q.matmul(&k.t()?)?.reshape((b, j, h, t, t))?.broadcast_add(&ctx.temporal)?;
-        let p = super::layers::softmax(&logits)?.reshape((b * j, h, t, t))?;
-        let y = merge_heads(&p.matmul(&v)?)?; // [B*J, T, d]
-        self.out.forward(&y)?.reshape((b, j, t, d))?.permute((0, 2, 1, 3))?.contiguous()
+        let qkv = project_qkv(&self.query, &self.key, &self.value, &x.reshape((b * t * j, d))?)?;
+        let y = fused::attention(&qkv, None, Groups::frames(b, t, j), self.heads, ctx.temporal.clone())?;
+        self.out.forward(&y)?.reshape((b, t, j, d))
     }
 }
 
@@ -154,9 +141,9 @@ impl Layer {
     }
 
     /// `temb`: `[B, 1, 1, d]`.
-    fn forward(&self, x: &Tensor, temb: &Tensor, ctx: &Context, eq: &Tensor, ek: &Tensor) -> candle_core::Result<Tensor> {
-        let x = x.broadcast_add(&self.timestep.forward(temb)?)?;
-        let x = self.norm1.forward(&(&x + self.skeletal.forward(&x, ctx, eq, ek)?)?)?;
+    fn forward(&self, x: &Tensor, temb: &Tensor, ctx: &Context, bias_projection: &Tensor) -> candle_core::Result<Tensor> {
+        let x = fused::add_broadcast(x, &self.timestep.forward(temb)?, x.dim(0)?)?;
+        let x = self.norm1.forward(&(&x + self.skeletal.forward(&x, ctx, bias_projection)?)?)?;
         let x = self.norm2.forward(&(&x + self.temporal.forward(&x, ctx)?)?)?;
         self.norm3.forward(&(&x + self.ff.forward(&x)?)?)
     }
@@ -259,14 +246,14 @@ impl Denoiser {
         let rest = self.rest_in.forward(&x.narrow(1, 0, 1)?)?;
         let motion = self.motion_in.forward(&x.narrow(1, 1, t - 1)?)?;
         let names = zero_where_masked(&batch.names, &batch.joint_mask.unsqueeze(2)?)?;
-        let mut h = Tensor::cat(&[rest, motion], 1)?
-            .broadcast_add(&self.names_in.forward(&names)?.unsqueeze(1)?)?
+        let h = Tensor::cat(&[rest, motion], 1)?;
+        let mut h = fused::add_broadcast(&h, &self.names_in.forward(&names)?, b)?
             .broadcast_add(&sinusoid(&batch.positions, self.cfg.width)?.unsqueeze(2)?)?;
         let temb = sinusoid(&batch.timesteps.to_dtype(DType::F32)?, self.cfg.width)?.reshape((b, 1, 1, self.cfg.width))?;
-        let (eq, ek) = self.topology_tables()?;
+        let bias_projection = self.bias_projection()?;
         let mut kept = vec![None; keep_layers.len()];
         for (l, layer) in self.layers.iter().enumerate() {
-            h = layer.forward(&h, &temb, &ctx, &eq, &ek)?;
+            h = layer.forward(&h, &temb, &ctx, &bias_projection)?;
             for (slot, _) in keep_layers.iter().enumerate().filter(|(_, &k)| k == l) {
                 kept[slot] = Some(h.clone());
             }
@@ -300,32 +287,45 @@ impl Denoiser {
     }
 
     fn context(&self, batch: &Batch, b: usize, t: usize, j: usize) -> Result<Context, NnError> {
-        let dev = batch.x.device();
-        let one_hot = |m: &Tensor, n: usize| -> candle_core::Result<Tensor> {
-            let ids = Tensor::arange(0u32, n as u32, dev)?;
-            m.to_dtype(DType::U32)?.unsqueeze(D::Minus1)?.broadcast_eq(&ids)?.to_dtype(DType::F32)
-        };
+        let dmax = self.cfg.dmax;
+        let dist: Vec<u32> = batch.distances.to_dtype(DType::U32)?.flatten_all()?.to_vec1()?;
+        let rel: Vec<u32> = batch.relations.to_dtype(DType::U32)?.flatten_all()?.to_vec1()?;
         // Distances beyond dmax share the dmax row; an unknown relation id (> 5) adds no bias.
-        let dist = batch.distances.to_dtype(DType::U32)?.clamp(0u32, self.cfg.dmax as u32)?;
-        let joint_keys = ((batch.joint_mask.to_dtype(DType::F32)? - 1.0)? * -MASKED)?.reshape((b, 1, j, 1))?.broadcast_as((b, j, j, 1))?;
-        let parts = [one_hot(&dist, self.cfg.dmax + 1)?, one_hot(&batch.relations, RELATION_TYPES)?, joint_keys.contiguous()?];
-        let topology = Tensor::cat(&parts, D::Minus1)?; // [B, J(i), J(j), types + 1]
-        let types = topology.dim(D::Minus1)?;
-        let topology = topology.transpose(2, 3)?.contiguous()?.reshape((b * j, types, j))?;
-        let window = window_mask(t, self.cfg.window, dev)?;
-        let allowed = window.unsqueeze(0)?.broadcast_mul(&batch.frame_mask.to_dtype(DType::F32)?.unsqueeze(1)?)?; // [B, T(query), T(key)]
-        let temporal = ((allowed - 1.0)? * -MASKED)?.reshape((b, 1, 1, t, t))?;
-        Ok(Context { b, t, j, topology, temporal })
+        let types = dist
+            .iter()
+            .zip(&rel)
+            .map(|(&d, &r)| [d.min(dmax as u32) as u16, if (r as usize) < RELATION_TYPES { (dmax + 1) as u16 + r as u16 } else { fused::NO_TYPE }])
+            .collect();
+        let real = |m: &Tensor| -> candle_core::Result<Vec<bool>> { Ok(m.to_dtype(DType::F32)?.flatten_all()?.to_vec1::<f32>()?.iter().map(|&v| v != 0.0).collect()) };
+        let skeletal = Keys::Topology { types: Arc::new(types), key_ok: Arc::new(real(&batch.joint_mask)?), type_count: dmax + 1 + RELATION_TYPES };
+        let temporal = Keys::Window { half: self.cfg.window / 2, frame_ok: Arc::new(real(&batch.frame_mask)?) };
+        Ok(Context { b, t, j, skeletal, temporal })
     }
 
-    /// The query and key tables per head, `[H, dh, (dmax+1) + 6]` each (distance rows first).
-    fn topology_tables(&self) -> candle_core::Result<(Tensor, Tensor)> {
-        let (h, dh) = (self.cfg.heads, self.cfg.head_dim());
+    /// The topology tables as one `[3d, H * types]` matrix for the fused q/k/v rows: the query
+    /// block maps head h's query to `Eq[type]·q` in column `h * types + type`, the key block
+    /// likewise for `Ek`, the value block is zero; scaled by 1/sqrt(head_dim) like the logits.
+    /// Types are the `dmax + 1` distances, then the 6 relations.
+    fn bias_projection(&self) -> candle_core::Result<Tensor> {
+        let (h, dh, d) = (self.cfg.heads, self.cfg.head_dim(), self.cfg.width);
+        let types = self.cfg.dmax + 1 + RELATION_TYPES;
+        let dev = self.distance_query.device();
+        let mut block = vec![0f32; d * h * types];
+        for row in 0..d {
+            for ty in 0..types {
+                block[row * h * types + (row / dh) * types + ty] = 1.0;
+            }
+        }
+        let block = Tensor::from_vec(block, (d, h * types), dev)?;
         let per_head = |a: &Tensor, b: &Tensor| -> candle_core::Result<Tensor> {
-            let both = Tensor::cat(&[a, b], 0)?; // [types, d]
-            let types = both.dim(0)?;
-            both.reshape((types, h, dh))?.permute((1, 2, 0))?.contiguous()
+            // [types, d] -> [d, types] -> repeated per head, kept on the head's own rows.
+            Tensor::cat(&[a, b], 0)?.t()?.repeat((1, h))?.mul(&block)
         };
-        Ok((per_head(&self.distance_query, &self.relation_query)?, per_head(&self.distance_key, &self.relation_key)?))
+        let scale = 1.0 / (dh as f64).sqrt();
+        let projection = Tensor::cat(
+            &[per_head(&self.distance_query, &self.relation_query)?, per_head(&self.distance_key, &self.relation_key)?, Tensor::zeros((d, h * types), DType::F32, dev)?],
+            0,
+        )?;
+        projection * scale
     }
 }

@@ -33,11 +33,19 @@ impl Linear {
         Ok(Linear { weight, bias, inputs, outputs })
     }
 
+    pub fn weight(&self) -> &Tensor {
+        &self.weight
+    }
+
+    pub fn bias(&self) -> &Tensor {
+        &self.bias
+    }
+
     pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
         let dims = x.dims().to_vec();
         let rows: usize = dims[..dims.len().saturating_sub(1)].iter().product();
         let flat = x.reshape((rows, self.inputs))?;
-        let y = flat.matmul(&self.weight.t()?)?.broadcast_add(&self.bias)?;
+        let y = super::fused::add_broadcast(&flat.matmul(&self.weight.t()?)?, &self.bias, 1)?;
         let mut out = dims;
         if let Some(last) = out.last_mut() {
             *last = self.outputs;
@@ -61,12 +69,10 @@ impl LayerNorm {
         Ok(LayerNorm { weight, bias, eps })
     }
 
+    /// One fused pass forward and one backward (`fused::layer_norm`); the test below checks it
+    /// against the textbook composition.
     pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
-        let mean = x.mean_keepdim(D::Minus1)?;
-        let centred = x.broadcast_sub(&mean)?;
-        let var = centred.sqr()?.mean_keepdim(D::Minus1)?;
-        let normed = centred.broadcast_div(&(var + self.eps)?.sqrt()?)?;
-        normed.broadcast_mul(&self.weight)?.broadcast_add(&self.bias)
+        super::fused::layer_norm(x, &self.weight, &self.bias, self.eps)
     }
 }
 
