@@ -16,12 +16,21 @@
 //! `arthropod` (spider, centipede, crab), `undulating` (snake, fish) and `bird`.
 
 mod arthropod;
+mod arthropod_actions;
 mod bird;
+mod body_actions;
 mod legged;
+mod legged_actions;
+mod route;
+mod training;
 mod undulating;
+
+pub use training::{actions, proportions, training_clip, write_training_zoo, Action, Clip, Proportions, CLIP_FRAMES};
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod training_tests;
 
 use crate::bvh::{self, Bvh, Channel};
 use crate::motion::Motion;
