@@ -145,7 +145,8 @@ pub(crate) struct Clock {
 }
 
 impl Clock {
-    fn real(&self, tau: f64) -> f64 {
+    /// Real time of clock time `tau`.
+    pub fn real(&self, tau: f64) -> f64 {
         match self.pause {
             Some((a, b)) if tau >= a => tau + (b - a),
             _ => tau,
