@@ -54,7 +54,7 @@ pub(super) fn spider(job: &Job, rng: &mut SplitMix64) -> Clip {
         for (k, (leg, left, i)) in legs.iter().enumerate() {
             let mut f = feet[k].at(t);
             // Waiting, the front legs tap in turn: up and down on the spot.
-            if *i == 0 {
+            if *i == 0 && job.action == Action::Idle {
                 let phase = t / tap_period + if *left { 0.0 } else { 0.5 };
                 f.at.y += rest * 0.035 * r * wave(phase).max(0.0).powi(2);
             }

@@ -72,6 +72,7 @@ pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
         .iter()
         .zip(touchdown)
         .map(|(&(_, _, x), td)| plan.foot(job, FootSpec { home: v3(x, 0.0, ball.z), lag: 0.0, touchdown: td }))
+        .map(|f| if run { f.sharp() } else { f })
         .collect();
     let (ankle_y, hip_drop) = (0.08 * k, 0.06 * k);
     let heel_rise = rng.vary(if run { 30.0 } else { 22.0 }, 0.1);
@@ -95,7 +96,8 @@ pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
         let cycle_y = if run { -cwave(2.0 * (c - gait.duty / 2.0)) } else { cwave(2.0 * (c - gait.duty / 2.0)) };
         let y = a * (walk_y + bob * cycle_y) + rest * (stand_y + 0.004 * r * idle.breath(t));
         // Standing, the weight moves over one leg and back; the pelvis drops on the free side.
-        let shift = rest * idle.shift(t);
+        // A pause inside a walk is too short for shifting the weight about.
+        let shift = rest * idle.shift(t) * if job.action == Action::Idle { 1.0 } else { 0.15 };
         let yaw = -yaw_amp * a * cwave(c);
         let root = frame.rot() * ry(yaw) * rx(lean * a + 2.0 * rest) * rz(-3.0 * shift);
         p.root(frame.apply(v3(0.035 * k * shift, y, 0.0)), root);
@@ -197,7 +199,8 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
         let lh = touchdown[2];
         let y = a * (walk_y + bob * cwave(2.0 * (c - lh - gait.duty / 2.0)))
             + rest * (stand_y + 0.003 * r * idle.breath(t));
-        let shift = rest * idle.shift(t);
+        // A pause inside a walk is too short for shifting the weight about.
+        let shift = rest * idle.shift(t) * if job.action == Action::Idle { 1.0 } else { 0.15 };
         let roll = roll_amp * a * wave(c - lh) + 1.5 * shift;
         let yaw = yaw_amp * a * wave(c - lh + 0.25);
         p.root(frame.apply(v3(0.01 * r * shift, y, 0.0)), frame.rot() * ry(yaw) * rz(roll));

@@ -180,6 +180,9 @@ pub(crate) struct FootPlan {
     plants: Vec<Plant>,
     lift: f64,
     stride: f64,
+    /// Running swing: the foot leaves and meets the ground with vertical speed (push-off and
+    /// strike), so both feet are clearly off the ground during the flight phase.
+    sharp: bool,
 }
 
 /// What a foot is: its ground contact in the body frame (`home`, y ignored), how far behind
@@ -207,7 +210,7 @@ impl FootPlan {
         if !stepping || !(clock.period > 0.0) {
             let (at, yaw) = spot(route.s_at(0.0));
             let plants = vec![Plant { land: f64::NEG_INFINITY, lift: f64::INFINITY, at, yaw }];
-            return FootPlan { plants, lift, stride };
+            return FootPlan { plants, lift, stride, sharp: false };
         }
         let p = clock.period;
         // Lift-offs in clock time are (n + touchdown + duty) periods; map each to real time.
@@ -231,7 +234,12 @@ impl FootPlan {
             let (at, yaw) = spot(s);
             plants.push(Plant { land, lift: lift_t, at, yaw });
         }
-        FootPlan { plants, lift, stride }
+        FootPlan { plants, lift, stride, sharp: false }
+    }
+
+    /// The same plan with a running swing (see `sharp`).
+    pub fn sharp(self) -> FootPlan {
+        FootPlan { sharp: true, ..self }
     }
 
     pub fn at(&self, t: f64) -> FootNow {
@@ -251,7 +259,7 @@ impl FootPlan {
         let step = a.at.distance(b.at);
         let lift = self.lift * (0.35 + 0.65 * (2.0 * step / self.stride).min(1.0));
         let mut at = a.at.lerp(b.at, progress);
-        at.y = lift * 0.5 * (1.0 - (TAU * u).cos());
+        at.y = if self.sharp { lift * (std::f64::consts::PI * u).sin() } else { lift * 0.5 * (1.0 - (TAU * u).cos()) };
         FootNow { at, yaw: a.yaw + (b.yaw - a.yaw) * progress, swing: u.max(1e-9) }
     }
 
