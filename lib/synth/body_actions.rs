@@ -92,11 +92,15 @@ pub(super) fn bird(job: &Job, rng: &mut SplitMix64) -> Clip {
             // Flapping as the example bird does while walking, a full beat per hop, folded
             // and ruffled while standing.
             let beat = if hop { c } else { 2.0 * c };
-            let f = flap * a;
+            // Hopping needs the wings for balance; walking birds keep them mostly folded
+            // with a small flick per step.
+            let (f, fold) = if hop { (flap * a, 0.3 + 0.7 * rest) } else { (0.2 * flap * a, 0.8 + 0.2 * rest) };
+            // Folded, the wing lies in a Z against the body (arm back, forearm forward, hand
+            // back), with a ruffle now and then.
             let q = [
-                rz(10.0 + f * wave(beat) + 3.0 * rest * wave(t / 1.7)) * ry(-8.0 * a * cwave(beat)),
-                rz(-0.25 * f * wave(beat - 0.12)) * ry(12.0 * a * (1.0 - cwave(beat)) / 2.0),
-                rz(-0.2 * f * wave(beat - 0.22)),
+                rz(10.0 + f * wave(beat) + 3.0 * rest * wave(t / 1.7)) * ry(-8.0 * a * cwave(beat) + 80.0 * fold),
+                rz(-0.25 * f * wave(beat - 0.12)) * ry(12.0 * a * (1.0 - cwave(beat)) / 2.0 - 160.0 * fold),
+                rz(-0.2 * f * wave(beat - 0.22)) * ry(150.0 * fold),
             ];
             for (k, &j) in w.iter().enumerate() {
                 p.local(j, if i == 0 { q[k] } else { mirror(q[k]) });

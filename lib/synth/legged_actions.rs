@@ -227,11 +227,12 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
             // Flapping while moving (for balance), folded and stirring while standing.
             let beat = if trot { 2.0 * c } else { c };
             let f = flap * a;
-            let fold = 25.0 * rest;
+            // Folding is a Z: the arm swings back, the forearm forward along it, the hand back.
+            let fold = rest;
             let q = [
-                rz(15.0 + f * wave(beat) + 5.0 * rest * idle.breath(t)) * ry(-fold),
-                rz(-0.35 * f * wave(beat - 0.1)) * ry(10.0 * a * (1.0 - cwave(beat)) / 2.0 + fold),
-                rz(-0.3 * f * wave(beat - 0.2)) * ry(-0.8 * fold),
+                rz(15.0 + f * wave(beat) + 5.0 * rest * idle.breath(t)) * ry(70.0 * fold),
+                rz(-0.35 * f * wave(beat - 0.1)) * ry(10.0 * a * (1.0 - cwave(beat)) / 2.0 - 150.0 * fold),
+                rz(-0.3 * f * wave(beat - 0.2)) * ry(140.0 * fold),
             ];
             for (i, &j) in w.iter().enumerate() {
                 p.local(j, if side == 0 { q[i] } else { mirror(q[i]) });

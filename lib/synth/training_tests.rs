@@ -225,3 +225,27 @@ fn the_training_zoo_writes_one_folder_per_body() {
     assert_eq!(stop.split('\t').nth(2).unwrap().split(',').count(), 2, "{stop}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The same checks over many more bodies (about 6 s in a debug build: `cargo test --lib
+/// synth::training_tests -- --ignored`). Extreme proportions are where legs run out of reach.
+#[test]
+#[ignore]
+fn feet_plant_on_every_variant() {
+    for name in creature_names() {
+        for &action in actions(name) {
+            if matches!(*name, "snake" | "fish") || action == Action::Idle {
+                continue;
+            }
+            for variant in 0..16 {
+                let c = clip(name, variant, action);
+                let rows = planting(&c.skeleton, &c.motion);
+                let worst = rows.iter().map(|r| r.2).fold(0.0, f64::max);
+                let share = rows.iter().map(|r| r.1).fold(1.0, f64::min);
+                let world = c.motion.forward_kinematics(&c.skeleton);
+                let lowest = world.positions.iter().map(|p| p.y).fold(f64::INFINITY, f64::min) / c.skeleton.rest_height();
+                let what = format!("{name} v{variant} {action:?} {:?}", proportions(name, variant));
+                assert!(worst < 0.1 && share > 0.2 && lowest > -0.005, "{what}: stance {worst:.3} share {share:.2} low {lowest:.4}");
+            }
+        }
+    }
+}
