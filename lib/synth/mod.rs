@@ -14,6 +14,12 @@
 //! Layout: this module holds the API and the shared machinery (PRNG, skeleton builder, per-frame
 //! pose solver, IK, gait timing); the creatures live in `legged` (biped, quadruped, dragon),
 //! `arthropod` (spider, centipede, crab), `undulating` (snake, fish) and `bird`.
+//!
+//! The training zoo (`training_clip`, `write_training_zoo`) reuses those bodies with other
+//! proportions and joint counts and gives each family several actions (walk, run, idle, turn,
+//! walk-stop-walk, ...): `training` holds its API, `route` the ground track and foot planning
+//! that let bodies stop and curve, and `legged_actions`, `arthropod_actions` and `body_actions`
+//! the families' actions.
 
 mod arthropod;
 mod arthropod_actions;

@@ -207,7 +207,7 @@ impl FootPlan {
             (at, f.yaw)
         };
         let stride = 2.0 * reach / clock.duty.max(1e-6);
-        if !stepping || !(clock.period > 0.0) {
+        if !stepping || clock.period.is_nan() || clock.period <= 0.0 {
             let (at, yaw) = spot(route.s_at(0.0));
             let plants = vec![Plant { land: f64::NEG_INFINITY, lift: f64::INFINITY, at, yaw }];
             return FootPlan { plants, lift, stride, sharp: false };

@@ -111,7 +111,7 @@ pub fn proportions(name: &str, variant: u64) -> Option<Proportions> {
         let [body_joints, neck_joints, tail_joints] = base;
         return Some(Proportions { size: 1.0, limbs: 1.0, neck: 1.0, tail: 1.0, body_joints, neck_joints, tail_joints });
     }
-    let mut rng = SplitMix64::new(fnv1a(name) ^ variant.wrapping_mul(0x2545_f491_4f6c_dd1d) ^ 0x7661_7269_616e_74);
+    let mut rng = SplitMix64::new(fnv1a(name) ^ variant.wrapping_mul(0x2545_f491_4f6c_dd1d) ^ 0x0076_6172_6961_6e74);
     let size = rng.range(0.6f64.ln(), 1.5f64.ln()).exp();
     let limbs = rng.range(0.78, 1.25);
     let neck = rng.range(0.78, 1.25);
