@@ -249,3 +249,28 @@ fn feet_plant_on_every_variant() {
         }
     }
 }
+
+#[test]
+fn foot_plans_reduce_to_the_constant_speed_gait() {
+    use super::route::{speed_profile, Clock, FootPlan, FootSpec, Route};
+    // Straight on at constant speed, the general planner must place feet exactly where the
+    // example creatures' closed-form gait does.
+    let gait = Gait { period: 0.9, duty: 0.65, stride: 0.5, lift: 0.06 };
+    let route = Route::new(-5.0, 10.0, 0.0, 0.0, speed_profile(gait.speed(), None, 0.6), |_| 0.0);
+    let clock = Clock { period: gait.period, duty: gait.duty, pause: None };
+    for touchdown in [0.0, 0.3, 0.75] {
+        let home = v3(0.1, 0.0, 0.4);
+        let plan = FootPlan::new(&route, &clock, &FootSpec { home, lag: 0.0, touchdown }, 6.0, true, gait.half_reach(), gait.lift);
+        for f in 0..150 {
+            let t = f as f64 * FRAME_TIME;
+            let (now, want) = (plan.at(t), gait.foot(t, touchdown));
+            let want = v3(home.x, want.lift, home.z + want.forward);
+            assert!(now.at.distance(want) < 1e-6, "touchdown {touchdown}, t {t:.3}: {} vs {want}", now.at);
+        }
+    }
+    // Along a curve the track keeps its arc length and turns by curvature x distance.
+    let curve = Route::new(-1.0, 5.0, 0.0, 0.0, |_| 1.0, |_| 0.5);
+    assert!((curve.s_at(4.0) - 4.0).abs() < 1e-9);
+    assert!((curve.at_time(4.0).yaw - 2.0).abs() < 1e-6, "{}", curve.at_time(4.0).yaw);
+    assert!(curve.at_arc(2.0).pos.distance(curve.at_time(2.0).pos) < 1e-6);
+}
