@@ -21,9 +21,9 @@ pub(super) fn spider(job: &Job, rng: &mut SplitMix64) -> Clip {
     let r = job.shape.size * job.shape.limbs;
     let fast = job.action == Action::Run;
     let gait = if fast {
-        Gait { period: rng.vary(0.4, 0.06), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.15, 0.08), lift: rng.vary(0.04, 0.1) }
+        Gait { period: rng.vary(0.4, 0.06), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.15, 0.15), lift: rng.vary(0.04, 0.1) }
     } else {
-        Gait { period: rng.vary(0.6, 0.06), duty: rng.vary(0.55, 0.03), stride: rng.vary(0.11, 0.08), lift: rng.vary(0.035, 0.1) }
+        Gait { period: rng.vary(0.6, 0.06), duty: rng.vary(0.55, 0.03), stride: rng.vary(0.11, 0.15), lift: rng.vary(0.035, 0.1) }
     };
     let gait = scaled(gait, r);
     let plan = Plan::new(job, gait, 0.0, 0.0, rng);
@@ -70,9 +70,9 @@ pub(super) fn crab(job: &Job, rng: &mut SplitMix64) -> Clip {
     let r = job.shape.size * job.shape.limbs;
     let fast = job.action == Action::Run;
     let gait = if fast {
-        Gait { period: rng.vary(0.38, 0.06), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.14, 0.08), lift: rng.vary(0.045, 0.1) }
+        Gait { period: rng.vary(0.38, 0.06), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.14, 0.15), lift: rng.vary(0.045, 0.1) }
     } else {
-        Gait { period: rng.vary(0.55, 0.06), duty: rng.vary(0.55, 0.03), stride: rng.vary(0.1, 0.08), lift: rng.vary(0.04, 0.1) }
+        Gait { period: rng.vary(0.55, 0.06), duty: rng.vary(0.55, 0.03), stride: rng.vary(0.1, 0.15), lift: rng.vary(0.04, 0.1) }
     };
     let gait = scaled(gait, r);
     // Facing -x and walking towards its left, as the example crab does.
@@ -123,9 +123,9 @@ pub(super) fn centipede(job: &Job, rng: &mut SplitMix64) -> Clip {
     let r = job.shape.size * job.shape.limbs;
     let fast = job.action == Action::Run;
     let gait = if fast {
-        Gait { period: rng.vary(0.28, 0.06), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.07, 0.08), lift: rng.vary(0.018, 0.1) }
+        Gait { period: rng.vary(0.28, 0.06), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.07, 0.15), lift: rng.vary(0.018, 0.1) }
     } else {
-        Gait { period: rng.vary(0.36, 0.06), duty: rng.vary(0.55, 0.03), stride: rng.vary(0.05, 0.08), lift: rng.vary(0.015, 0.1) }
+        Gait { period: rng.vary(0.36, 0.06), duty: rng.vary(0.55, 0.03), stride: rng.vary(0.05, 0.15), lift: rng.vary(0.015, 0.1) }
     };
     let gait = scaled(gait, r);
     let plan = Plan::new(job, gait, 0.0, 0.0, rng);

@@ -22,9 +22,9 @@ pub(super) fn bird(job: &Job, rng: &mut SplitMix64) -> Clip {
     let r = shape.size * shape.limbs;
     let hop = job.action == Action::Hop;
     let gait = if hop {
-        Gait { period: rng.vary(0.42, 0.06), duty: rng.vary(0.42, 0.03), stride: rng.vary(0.2, 0.08), lift: rng.vary(0.06, 0.1) }
+        Gait { period: rng.vary(0.42, 0.06), duty: rng.vary(0.42, 0.03), stride: rng.vary(0.2, 0.15), lift: rng.vary(0.06, 0.1) }
     } else {
-        Gait { period: rng.vary(0.5, 0.06), duty: rng.vary(0.6, 0.03), stride: rng.vary(0.13, 0.08), lift: rng.vary(0.03, 0.1) }
+        Gait { period: rng.vary(0.5, 0.06), duty: rng.vary(0.6, 0.03), stride: rng.vary(0.13, 0.15), lift: rng.vary(0.03, 0.1) }
     };
     let gait = Gait { period: gait.period * r.sqrt(), stride: gait.stride * r, lift: gait.lift * r, ..gait };
     let plan = Plan::new(job, gait, 0.0, 0.0, rng);

@@ -60,9 +60,9 @@ pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
     let leg_len = 0.84 * r;
     let run = job.action == Action::Run;
     let gait = if run {
-        Gait { period: rng.vary(0.7, 0.05), duty: rng.vary(0.35, 0.03), stride: rng.vary(2.0, 0.08), lift: rng.vary(0.3, 0.1) }
+        Gait { period: rng.vary(0.7, 0.05), duty: rng.vary(0.35, 0.03), stride: rng.vary(2.0, 0.15), lift: rng.vary(0.3, 0.1) }
     } else {
-        Gait { period: rng.vary(1.1, 0.06), duty: rng.vary(0.6, 0.03), stride: rng.vary(1.05, 0.08), lift: rng.vary(0.07, 0.1) }
+        Gait { period: rng.vary(1.1, 0.06), duty: rng.vary(0.6, 0.03), stride: rng.vary(1.05, 0.15), lift: rng.vary(0.07, 0.1) }
     };
     let gait = froude(gait, r);
     let plan = Plan::new(job, gait, 0.0, 0.0, rng);
@@ -160,9 +160,9 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
     let r = k * shape.limbs;
     let trot = job.action == Action::Run;
     let gait = if trot {
-        Gait { period: rng.vary(0.55, 0.05), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.9, 0.08), lift: rng.vary(0.08, 0.1) }
+        Gait { period: rng.vary(0.55, 0.05), duty: rng.vary(0.45, 0.03), stride: rng.vary(0.9, 0.15), lift: rng.vary(0.08, 0.1) }
     } else {
-        Gait { period: rng.vary(0.9, 0.06), duty: rng.vary(0.68, 0.03), stride: rng.vary(0.5, 0.08), lift: rng.vary(0.06, 0.1) }
+        Gait { period: rng.vary(0.9, 0.06), duty: rng.vary(0.68, 0.03), stride: rng.vary(0.5, 0.15), lift: rng.vary(0.06, 0.1) }
     };
     // Dragons are bigger than their legs suggest: Froude-scale from the dog on leg length.
     let gait = froude(gait, r);
