@@ -26,6 +26,22 @@ fn mean_speed(track: &[DVec3], a: usize, b: usize) -> f64 {
     track[b - 1].distance(track[a]) / ((b - 1 - a) as f64 * FRAME_TIME)
 }
 
+/// Lowest height any joint or End Site reaches in the clip.
+fn lowest_point(c: &Clip) -> f64 {
+    let world = c.motion.forward_kinematics(&c.skeleton);
+    let mut lowest = f64::INFINITY;
+    for f in 0..c.motion.frames {
+        for (j, joint) in c.skeleton.joints.iter().enumerate() {
+            let at = world.position(f, j);
+            lowest = lowest.min(at.y);
+            for e in &joint.end_sites {
+                lowest = lowest.min((at + world.rotations[f * world.joints + j] * *e).y);
+            }
+        }
+    }
+    lowest
+}
+
 fn main_action(name: &str) -> Action {
     if actions(name).contains(&Action::Walk) {
         Action::Walk
@@ -105,10 +121,9 @@ fn every_action_is_finite_and_stays_above_the_ground() {
                 assert_eq!(c.motion.frames, FRAMES);
                 assert!(c.motion.rotations.iter().all(|q| q.is_finite()), "{name} {action:?}: rotation");
                 assert!(c.motion.translations.iter().all(|t| t.is_finite()), "{name} {action:?}: translation");
-                let world = c.motion.forward_kinematics(&c.skeleton);
-                let lowest = world.positions.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+                let lowest = lowest_point(&c);
                 let h = c.skeleton.rest_height().max(0.05);
-                assert!(lowest > -0.01 * h, "{name} v{variant} {action:?}: a joint reaches y = {lowest:.4}");
+                assert!(lowest > -0.01 * h, "{name} v{variant} {action:?}: a joint or End Site reaches y = {lowest:.4}");
             }
         }
     }
@@ -241,8 +256,7 @@ fn feet_plant_on_every_variant() {
                 let rows = planting(&c.skeleton, &c.motion);
                 let worst = rows.iter().map(|r| r.2).fold(0.0, f64::max);
                 let share = rows.iter().map(|r| r.1).fold(1.0, f64::min);
-                let world = c.motion.forward_kinematics(&c.skeleton);
-                let lowest = world.positions.iter().map(|p| p.y).fold(f64::INFINITY, f64::min) / c.skeleton.rest_height();
+                let lowest = lowest_point(&c) / c.skeleton.rest_height();
                 let what = format!("{name} v{variant} {action:?} {:?}", proportions(name, variant));
                 assert!(worst < 0.1 && share > 0.2 && lowest > -0.005, "{what}: stance {worst:.3} share {share:.2} low {lowest:.4}");
             }
