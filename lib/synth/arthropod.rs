@@ -11,15 +11,15 @@
 use super::*;
 
 /// An arachnid-style leg: coxa (turns the leg plane), femur up, tibia down, foot to the ground.
-struct JointedLeg {
-    coxa: usize,
-    ik: Leg,
+pub(super) struct JointedLeg {
+    pub coxa: usize,
+    pub ik: Leg,
     /// Horizontal rest direction of the leg plane.
-    dir: DVec3,
+    pub dir: DVec3,
     /// The foot's End Site offset (where it touches the ground).
-    end: DVec3,
+    pub end: DVec3,
     /// Rest ground contact relative to the root's ground projection.
-    home: DVec3,
+    pub home: DVec3,
 }
 
 /// Leg dimensions along the leg plane: (out, up) of each bone.
@@ -63,7 +63,7 @@ fn jointed_leg(b: &mut Builder, parent: usize, names: [String; 4], left: bool, a
 /// world rotation `foot`. Keeping the foot's rotation fixed (rather than turning it with the
 /// leg) keeps the foot joint itself still during stance, which is what contact detectors
 /// measure; the coxa then aims the leg plane at the foot joint.
-fn place_jointed_leg(p: &mut Pose, leg: &JointedLeg, contact: DVec3, foot: DQuat) {
+pub(super) fn place_jointed_leg(p: &mut Pose, leg: &JointedLeg, contact: DVec3, foot: DQuat) {
     let target = contact - foot * leg.end;
     let pivot = p.pos(leg.coxa);
     let mut h = target - pivot;
@@ -72,19 +72,34 @@ fn place_jointed_leg(p: &mut Pose, leg: &JointedLeg, contact: DVec3, foot: DQuat
     p.leg(&leg.ik, target, DVec3::Y, foot);
 }
 
-/// An eight-legged walker in alternating tetrapod gait (L1 R2 L3 R4 against R1 L2 R3 L4),
-/// six channels on every joint as Truebones exports them, snake_case names.
-pub(super) fn spider(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+/// The spider's joints: body parts and (leg, left, index) per leg.
+pub(super) struct SpiderBody {
+    pub skel: Skeleton,
+    pub body_y: f64,
+    pub abdomen: usize,
+    pub fangs: [usize; 2],
+    pub legs: Vec<(JointedLeg, bool, usize)>,
+}
+
+/// The spider scaled by `shape` (size everything, limbs the legs).
+pub(super) fn spider_body(shape: &Proportions) -> SpiderBody {
     let layout = Layout { root_order: "ZYX", joint_order: "ZYX", all_positions: true };
-    let dims = LegDims { attach: 0.04, coxa: 0.025, femur: (0.08, 0.08), tibia: (0.08, -0.12), end: (0.015, -0.04) };
+    let (k, l) = (shape.size, shape.size * shape.limbs);
+    let dims = LegDims {
+        attach: 0.04 * k,
+        coxa: 0.025 * l,
+        femur: (0.08 * l, 0.08 * l),
+        tibia: (0.08 * l, -0.12 * l),
+        end: (0.015 * l, -0.04 * l),
+    };
     let body_y = dims.body_height();
     let mut b = Builder::new("cephalothorax", v3(0.0, body_y, 0.0), layout);
-    let abdomen = b.add("abdomen", 0, v3(0.0, 0.015, -0.045));
-    b.end(abdomen, v3(0.0, 0.01, -0.1));
-    let fang_l = b.add("chelicera_l", 0, v3(0.01, -0.005, 0.035));
-    b.end(fang_l, v3(0.0, -0.02, 0.01));
-    let fang_r = b.add("chelicera_r", 0, v3(-0.01, -0.005, 0.035));
-    b.end(fang_r, v3(0.0, -0.02, 0.01));
+    let abdomen = b.add("abdomen", 0, v3(0.0, 0.015 * k, -0.045 * k));
+    b.end(abdomen, v3(0.0, 0.01 * k, -0.1 * k * shape.tail));
+    let fang_l = b.add("chelicera_l", 0, v3(0.01 * k, -0.005 * k, 0.035 * k));
+    b.end(fang_l, v3(0.0, -0.02 * k, 0.01 * k));
+    let fang_r = b.add("chelicera_r", 0, v3(-0.01 * k, -0.005 * k, 0.035 * k));
+    b.end(fang_r, v3(0.0, -0.02 * k, 0.01 * k));
     let angles = [35.0, 70.0, 110.0, 148.0];
     let mut legs = Vec::new();
     for left in [true, false] {
@@ -94,7 +109,14 @@ pub(super) fn spider(rng: &mut SplitMix64) -> (Skeleton, Motion) {
             legs.push((jointed_leg(&mut b, 0, names, left, angle, &dims), left, i));
         }
     }
-    let skel = b.build();
+    SpiderBody { skel: b.build(), body_y, abdomen, fangs: [fang_l, fang_r], legs }
+}
+
+/// An eight-legged walker in alternating tetrapod gait (L1 R2 L3 R4 against R1 L2 R3 L4),
+/// six channels on every joint as Truebones exports them, snake_case names.
+pub(super) fn spider(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    let body = spider_body(&training::proportions("spider", 0).expect("spider exists"));
+    let SpiderBody { skel, body_y, abdomen, fangs: [fang_l, fang_r], legs } = body;
 
     let (frames, period) = frames_for(rng.vary(0.6, 0.06), 4);
     let gait = Gait { period, duty: rng.vary(0.55, 0.03), stride: rng.vary(0.11, 0.08), lift: rng.vary(0.035, 0.1) };
@@ -123,31 +145,45 @@ pub(super) fn spider(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     (skel, motion)
 }
 
-/// A crab: four legs a side plus two claws, scuttling sideways to its left. The rest pose faces
-/// +z like every creature; the clip turns it a quarter so that its sideways walk still advances
-/// along +z.
-pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+/// The crab's joints: eyes, claws (merus, carpus, finger) and (leg, left, index) per leg.
+pub(super) struct CrabBody {
+    pub skel: Skeleton,
+    pub body_y: f64,
+    pub eyes: Vec<usize>,
+    pub claws: Vec<(usize, usize, usize)>,
+    pub legs: Vec<(JointedLeg, bool, usize)>,
+}
+
+/// The crab scaled by `shape` (size everything, limbs the legs and claws).
+pub(super) fn crab_body(shape: &Proportions) -> CrabBody {
     let layout = Layout { root_order: "YXZ", joint_order: "XZY", all_positions: false };
-    let dims = LegDims { attach: 0.07, coxa: 0.02, femur: (0.08, 0.05), tibia: (0.07, -0.09), end: (0.03, -0.05) };
+    let (k, l) = (shape.size, shape.size * shape.limbs);
+    let dims = LegDims {
+        attach: 0.07 * k,
+        coxa: 0.02 * l,
+        femur: (0.08 * l, 0.05 * l),
+        tibia: (0.07 * l, -0.09 * l),
+        end: (0.03 * l, -0.05 * l),
+    };
     let body_y = dims.body_height();
     let mut b = Builder::new("Carapace", v3(0.0, body_y, 0.0), layout);
     let mut eyes = Vec::new();
     for left in [true, false] {
         let s = if left { 1.0 } else { -1.0 };
-        let eye = b.add(if left { "L_Eye" } else { "R_Eye" }, 0, v3(0.02 * s, 0.02, 0.06));
-        b.end(eye, v3(0.0, 0.03, 0.005));
+        let eye = b.add(if left { "L_Eye" } else { "R_Eye" }, 0, v3(0.02 * s * k, 0.02 * k, 0.06 * k));
+        b.end(eye, v3(0.0, 0.03 * k, 0.005 * k));
         eyes.push(eye);
     }
     let mut claws = Vec::new();
     for left in [true, false] {
         let s = if left { 1.0 } else { -1.0 };
         let side = if left { "L" } else { "R" };
-        let merus = b.add(&format!("{side}_Claw_Merus"), 0, v3(0.05 * s, 0.0, 0.05));
-        let carpus = b.add(&format!("{side}_Claw_Carpus"), merus, v3(0.05 * s, 0.01, 0.04));
-        let hand = b.add(&format!("{side}_Claw_Hand"), carpus, v3(0.01 * s, 0.0, 0.05));
-        b.end(hand, v3(0.0, -0.005, 0.06));
-        let finger = b.add(&format!("{side}_Claw_Finger"), carpus, v3(0.015 * s, 0.015, 0.05));
-        b.end(finger, v3(-0.003 * s, -0.008, 0.055));
+        let merus = b.add(&format!("{side}_Claw_Merus"), 0, v3(0.05 * s * k, 0.0, 0.05 * k));
+        let carpus = b.add(&format!("{side}_Claw_Carpus"), merus, v3(0.05 * s * l, 0.01 * l, 0.04 * l));
+        let hand = b.add(&format!("{side}_Claw_Hand"), carpus, v3(0.01 * s * l, 0.0, 0.05 * l));
+        b.end(hand, v3(0.0, -0.005 * l, 0.06 * l));
+        let finger = b.add(&format!("{side}_Claw_Finger"), carpus, v3(0.015 * s * l, 0.015 * l, 0.05 * l));
+        b.end(finger, v3(-0.003 * s * l, -0.008 * l, 0.055 * l));
         claws.push((merus, carpus, finger));
     }
     let angles = [62.0, 82.0, 102.0, 124.0];
@@ -159,7 +195,14 @@ pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
             legs.push((jointed_leg(&mut b, 0, names, left, angle, &dims), left, i));
         }
     }
-    let skel = b.build();
+    CrabBody { skel: b.build(), body_y, eyes, claws, legs }
+}
+
+/// A crab: four legs a side plus two claws, scuttling sideways to its left. The rest pose faces
+/// +z like every creature; the clip turns it a quarter so that its sideways walk still advances
+/// along +z.
+pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    let CrabBody { skel, body_y, eyes, claws, legs } = crab_body(&training::proportions("crab", 0).expect("crab exists"));
 
     let (frames, period) = frames_for(rng.vary(0.55, 0.06), 4);
     let gait = Gait { period, duty: rng.vary(0.55, 0.03), stride: rng.vary(0.1, 0.08), lift: rng.vary(0.04, 0.1) };
@@ -199,29 +242,46 @@ pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     (skel, motion)
 }
 
-/// A centipede: a chain of segments from the head back, one leg pair each, legs stepping in a
-/// metachronal wave (each pair lands a fixed fraction of a cycle after the pair in front, left
-/// and right in antiphase) and the body undulating with the same wavelength.
-pub(super) fn centipede(rng: &mut SplitMix64) -> (Skeleton, Motion) {
-    const SEGMENTS: usize = 12;
+/// The centipede's joints and dimensions.
+pub(super) struct CentipedeBody {
+    pub skel: Skeleton,
+    pub body_y: f64,
+    pub seg_len: f64,
+    pub head: usize,
+    pub antennae: Vec<usize>,
+    /// Segment joints, head segment (the root) first.
+    pub segments: Vec<usize>,
+    pub tail: usize,
+    /// (IK chain, home relative to its segment, segment index, left) per leg.
+    pub legs: Vec<(Leg, DVec3, usize, bool)>,
+    /// The foot's End Site (it stands on it).
+    pub claw: DVec3,
+}
+
+/// The centipede with `shape.body_joints` segments, scaled by `shape`.
+pub(super) fn centipede_body(shape: &Proportions) -> CentipedeBody {
+    let n_segments = shape.body_joints.max(2);
     let layout = Layout { root_order: "YXZ", joint_order: "YXZ", all_positions: false };
-    let seg_len = 0.05;
+    let (k, l) = (shape.size, shape.size * shape.limbs);
+    let seg_len = 0.05 * k;
     // Each leg: hip (`Leg`), knee (`Shin`) raised above the body, and a short foot standing
     // on the ground so the foot joint itself stays put in stance.
-    let (attach, upper, lower, claw) = (0.012, v3(0.05, 0.025, 0.0), v3(0.04, -0.054, 0.0), v3(0.0, -0.006, 0.0));
+    let (attach, upper, lower, claw) =
+        (0.012 * k, v3(0.05 * l, 0.025 * l, 0.0), v3(0.04 * l, -0.054 * l, 0.0), v3(0.0, -0.006 * l, 0.0));
     let body_y = -(upper.y + lower.y + claw.y);
     let mut b = Builder::new("Segment01", v3(0.0, body_y, 0.0), layout);
-    let head = b.add("Head", 0, v3(0.0, 0.004, 0.035));
+    let head = b.add("Head", 0, v3(0.0, 0.004 * k, 0.035 * k));
     let mut antennae = Vec::new();
     for left in [true, false] {
         let s = if left { 1.0 } else { -1.0 };
-        let a = b.add(if left { "Antenna_L" } else { "Antenna_R" }, head, v3(0.008 * s, 0.004, 0.02));
-        b.end(a, v3(0.04 * s, 0.015, 0.07));
+        let a = b.add(if left { "Antenna_L" } else { "Antenna_R" }, head, v3(0.008 * s * k, 0.004 * k, 0.02 * k));
+        let n = k * shape.neck;
+        b.end(a, v3(0.04 * s * n, 0.015 * n, 0.07 * n));
         antennae.push(a);
     }
     let mut segments = vec![0];
     let mut legs = Vec::new();
-    for k in 0..SEGMENTS {
+    for k in 0..n_segments {
         if k > 0 {
             let seg = b.add(&format!("Segment{:02}", k + 1), segments[k - 1], v3(0.0, 0.0, -seg_len));
             segments.push(seg);
@@ -232,13 +292,24 @@ pub(super) fn centipede(rng: &mut SplitMix64) -> (Skeleton, Motion) {
             let shin = b.add(&format!("Shin{:02}_{side}", k + 1), leg, v3(upper.x * s, upper.y, 0.0));
             let foot = b.add(&format!("Foot{:02}_{side}", k + 1), shin, v3(lower.x * s, lower.y, 0.0));
             b.end(foot, claw);
-            let home = v3((attach + upper.x + lower.x) * s, 0.0, -seg_len * k as f64);
+            let home = v3((attach + upper.x + lower.x) * s, 0.0, 0.0);
             legs.push((Leg { upper: leg, lower: shin, tip: Some(foot), rest_pole: DVec3::Y }, home, k, left));
         }
     }
-    let tail = b.add("Tail", segments[SEGMENTS - 1], v3(0.0, 0.0, -seg_len));
-    b.end(tail, v3(0.0, 0.005, -0.03));
-    let skel = b.build();
+    let tail = b.add("Tail", segments[n_segments - 1], v3(0.0, 0.0, -seg_len));
+    b.end(tail, v3(0.0, 0.005 * k, -0.03 * k * shape.tail));
+    CentipedeBody { skel: b.build(), body_y, seg_len, head, antennae, segments, tail, legs, claw }
+}
+
+/// A centipede: a chain of segments from the head back, one leg pair each, legs stepping in a
+/// metachronal wave (each pair lands a fixed fraction of a cycle after the pair in front, left
+/// and right in antiphase) and the body undulating with the same wavelength.
+pub(super) fn centipede(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    const SEGMENTS: usize = 12;
+    let body = centipede_body(&training::proportions("centipede", 0).expect("centipede exists"));
+    let CentipedeBody { skel, body_y, seg_len, head, antennae, segments, tail, claw, .. } = body;
+    // Homes along the body, as the constant-speed gait below wants them.
+    let legs: Vec<_> = body.legs.iter().map(|&(leg, home, k, left)| (leg, home - DVec3::Z * seg_len * k as f64, k, left)).collect();
 
     let (frames, period) = frames_for(rng.vary(0.36, 0.06), 8);
     let gait = Gait { period, duty: rng.vary(0.55, 0.03), stride: rng.vary(0.05, 0.08), lift: rng.vary(0.015, 0.1) };

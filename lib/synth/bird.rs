@@ -8,42 +8,69 @@
 
 use super::*;
 
-pub(super) fn bird(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+/// The bird's joints and leg dimensions.
+pub(super) struct BirdBody {
+    pub skel: Skeleton,
+    pub spine: usize,
+    pub chest: usize,
+    pub neck1: usize,
+    pub neck2: usize,
+    pub head: usize,
+    pub wings: Vec<[usize; 3]>,
+    /// (IK chain, hip x) left then right.
+    pub legs: Vec<(Leg, f64)>,
+    pub tail: [usize; 2],
+    pub hip_drop: f64,
+    pub shin: DVec3,
+    pub tarsus: DVec3,
+    pub ankle_y: f64,
+}
+
+/// The bird scaled by `shape` (size everything; limbs the legs and wings; neck and tail theirs).
+pub(super) fn bird_body(shape: &Proportions) -> BirdBody {
     let layout = Layout { root_order: "ZYX", joint_order: "ZYX", all_positions: false };
-    let (hip_drop, shin, tarsus, ankle_y) = (0.02, v3(0.0, -0.1, -0.03), v3(0.0, -0.1, 0.03), 0.02);
+    let (k, l, n, tl) = (shape.size, shape.size * shape.limbs, shape.size * shape.neck, shape.size * shape.tail);
+    let (hip_drop, shin, tarsus, ankle_y) = (0.02 * k, v3(0.0, -0.1 * l, -0.03 * l), v3(0.0, -0.1 * l, 0.03 * l), 0.02 * k);
     let pelvis_y = ankle_y - shin.y - tarsus.y + hip_drop;
     let mut b = Builder::new("Pelvis", v3(0.0, pelvis_y, 0.0), layout);
-    let spine = b.add("Spine", 0, v3(0.0, 0.02, 0.05));
-    let chest = b.add("Chest", spine, v3(0.0, 0.02, 0.05));
-    let neck1 = b.add("Neck1", chest, v3(0.0, 0.05, 0.03));
-    let neck2 = b.add("Neck2", neck1, v3(0.0, 0.05, 0.01));
-    let head = b.add("Head", neck2, v3(0.0, 0.03, 0.01));
-    b.end(head, v3(0.0, -0.005, 0.05));
+    let spine = b.add("Spine", 0, v3(0.0, 0.02 * k, 0.05 * k));
+    let chest = b.add("Chest", spine, v3(0.0, 0.02 * k, 0.05 * k));
+    let neck1 = b.add("Neck1", chest, v3(0.0, 0.05 * k, 0.03 * k));
+    let neck2 = b.add("Neck2", neck1, v3(0.0, 0.05 * n, 0.01 * n));
+    let head = b.add("Head", neck2, v3(0.0, 0.03 * n, 0.01 * n));
+    b.end(head, v3(0.0, -0.005 * k, 0.05 * k));
     let mut wings = Vec::new();
     for left in [true, false] {
         let (s, side) = if left { (1.0, "Left") } else { (-1.0, "Right") };
-        let w1 = b.add(&format!("{side}Wing1"), chest, v3(0.04 * s, 0.02, -0.01));
-        let w2 = b.add(&format!("{side}Wing2"), w1, v3(0.09 * s, 0.0, 0.0));
-        let w3 = b.add(&format!("{side}Wing3"), w2, v3(0.09 * s, 0.0, -0.01));
-        b.end(w3, v3(0.13 * s, 0.0, -0.03));
+        let w1 = b.add(&format!("{side}Wing1"), chest, v3(0.04 * s * k, 0.02 * k, -0.01 * k));
+        let w2 = b.add(&format!("{side}Wing2"), w1, v3(0.09 * s * l, 0.0, 0.0));
+        let w3 = b.add(&format!("{side}Wing3"), w2, v3(0.09 * s * l, 0.0, -0.01 * l));
+        b.end(w3, v3(0.13 * s * l, 0.0, -0.03 * l));
         wings.push([w1, w2, w3]);
     }
     let mut legs = Vec::new();
     for left in [true, false] {
         let (s, side) = if left { (1.0, "Left") } else { (-1.0, "Right") };
-        let thigh = b.add(&format!("{side}Thigh"), 0, v3(0.045 * s, -hip_drop, 0.0));
+        let thigh = b.add(&format!("{side}Thigh"), 0, v3(0.045 * s * k, -hip_drop, 0.0));
         let shin_j = b.add(&format!("{side}Shin"), thigh, shin);
         let foot = b.add(&format!("{side}Foot"), shin_j, tarsus);
-        let toe = b.add(&format!("{side}Toe"), foot, v3(0.0, -0.015, 0.04));
-        b.end(toe, v3(0.0, -0.005, 0.035));
-        let hallux = b.add(&format!("{side}Hallux"), foot, v3(0.0, -0.015, -0.02));
-        b.end(hallux, v3(0.0, -0.005, -0.02));
-        legs.push((Leg { upper: thigh, lower: shin_j, tip: Some(foot), rest_pole: DVec3::NEG_Z }, 0.045 * s));
+        let toe = b.add(&format!("{side}Toe"), foot, v3(0.0, -0.015 * k, 0.04 * k));
+        b.end(toe, v3(0.0, -0.005 * k, 0.035 * k));
+        let hallux = b.add(&format!("{side}Hallux"), foot, v3(0.0, -0.015 * k, -0.02 * k));
+        b.end(hallux, v3(0.0, -0.005 * k, -0.02 * k));
+        legs.push((Leg { upper: thigh, lower: shin_j, tip: Some(foot), rest_pole: DVec3::NEG_Z }, 0.045 * s * k));
     }
-    let tail1 = b.add("Tail1", 0, v3(0.0, 0.01, -0.05));
-    let tail2 = b.add("Tail2", tail1, v3(0.0, 0.01, -0.05));
-    b.end(tail2, v3(0.0, 0.0, -0.07));
+    let tail1 = b.add("Tail1", 0, v3(0.0, 0.01 * k, -0.05 * k));
+    let tail2 = b.add("Tail2", tail1, v3(0.0, 0.01 * tl, -0.05 * tl));
+    b.end(tail2, v3(0.0, 0.0, -0.07 * tl));
     let skel = b.build();
+    BirdBody { skel, spine, chest, neck1, neck2, head, wings, legs, tail: [tail1, tail2], hip_drop, shin, tarsus, ankle_y }
+}
+
+pub(super) fn bird(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    let body = bird_body(&training::proportions("bird", 0).expect("bird exists"));
+    let BirdBody { skel, spine, chest, neck1, neck2, head, wings, legs, tail: [tail1, tail2], hip_drop, shin, tarsus, ankle_y } =
+        body;
 
     let (frames, period) = frames_for(rng.vary(0.5, 0.06), 5);
     let gait = Gait { period, duty: rng.vary(0.6, 0.03), stride: rng.vary(0.13, 0.08), lift: rng.vary(0.03, 0.1) };

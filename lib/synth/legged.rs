@@ -10,38 +10,60 @@
 
 use super::*;
 
-/// Mixamo-named human walking: alternating legs, counter-swinging arms, a level head.
-pub(super) fn biped(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+/// The biped's joints, as the gaits need them.
+pub(super) struct BipedBody {
+    pub skel: Skeleton,
+    pub spine: [usize; 3],
+    pub neck: usize,
+    pub head: usize,
+    /// (arm, forearm, hand) left then right.
+    pub arms: Vec<(usize, usize, usize)>,
+    /// (IK chain, toe, hip x) left then right.
+    pub legs: Vec<(Leg, usize, f64)>,
+}
+
+/// The Mixamo-named human body scaled by `shape` (all factors 1 give the example biped).
+pub(super) fn biped_body(shape: &Proportions) -> BipedBody {
     let layout = Layout { root_order: "ZXY", joint_order: "ZXY", all_positions: false };
     let m = |n: &str| format!("mixamorig:{n}");
-    let mut b = Builder::new(&m("Hips"), v3(0.0, 0.98, 0.0), layout);
-    let spine = b.add(&m("Spine"), 0, v3(0.0, 0.1, 0.0));
-    let spine1 = b.add(&m("Spine1"), spine, v3(0.0, 0.12, 0.0));
-    let spine2 = b.add(&m("Spine2"), spine1, v3(0.0, 0.13, 0.0));
-    let neck = b.add(&m("Neck"), spine2, v3(0.0, 0.14, 0.01));
-    let head = b.add(&m("Head"), neck, v3(0.0, 0.09, 0.01));
-    b.end(head, v3(0.0, 0.18, 0.0));
+    let k = shape.size;
+    let (arm_k, leg_k, neck_k) = (k * shape.limbs, k * shape.limbs, k * shape.neck);
+    // Pelvis height follows the legs: hip drop and ankle scale with the body, the legs (0.84)
+    // with the limbs.
+    let mut b = Builder::new(&m("Hips"), v3(0.0, 0.98 * k + 0.84 * (leg_k - k), 0.0), layout);
+    let spine = b.add(&m("Spine"), 0, v3(0.0, 0.1 * k, 0.0));
+    let spine1 = b.add(&m("Spine1"), spine, v3(0.0, 0.12 * k, 0.0));
+    let spine2 = b.add(&m("Spine2"), spine1, v3(0.0, 0.13 * k, 0.0));
+    let neck = b.add(&m("Neck"), spine2, v3(0.0, 0.14 * k, 0.01 * k));
+    let head = b.add(&m("Head"), neck, v3(0.0, 0.09 * neck_k, 0.01 * neck_k));
+    b.end(head, v3(0.0, 0.18 * k, 0.0));
     let mut arms = Vec::new();
     for left in [true, false] {
         let (s, side) = if left { (1.0, "Left") } else { (-1.0, "Right") };
-        let sh = b.add(&m(&format!("{side}Shoulder")), spine2, v3(0.06 * s, 0.1, 0.0));
-        let arm = b.add(&m(&format!("{side}Arm")), sh, v3(0.12 * s, 0.0, 0.0));
-        let fore = b.add(&m(&format!("{side}ForeArm")), arm, v3(0.27 * s, 0.0, 0.0));
-        let hand = b.add(&m(&format!("{side}Hand")), fore, v3(0.25 * s, 0.0, 0.0));
-        b.end(hand, v3(0.18 * s, 0.0, 0.0));
+        let sh = b.add(&m(&format!("{side}Shoulder")), spine2, v3(0.06 * s * k, 0.1 * k, 0.0));
+        let arm = b.add(&m(&format!("{side}Arm")), sh, v3(0.12 * s * k, 0.0, 0.0));
+        let fore = b.add(&m(&format!("{side}ForeArm")), arm, v3(0.27 * s * arm_k, 0.0, 0.0));
+        let hand = b.add(&m(&format!("{side}Hand")), fore, v3(0.25 * s * arm_k, 0.0, 0.0));
+        b.end(hand, v3(0.18 * s * k, 0.0, 0.0));
         arms.push((arm, fore, hand));
     }
     let mut legs = Vec::new();
     for left in [true, false] {
         let (s, side) = if left { (1.0, "Left") } else { (-1.0, "Right") };
-        let up = b.add(&m(&format!("{side}UpLeg")), 0, v3(0.09 * s, -0.06, 0.0));
-        let knee = b.add(&m(&format!("{side}Leg")), up, v3(0.0, -0.43, 0.0));
-        let foot = b.add(&m(&format!("{side}Foot")), knee, v3(0.0, -0.41, 0.0));
-        let toe = b.add(&m(&format!("{side}ToeBase")), foot, v3(0.0, -0.06, 0.12));
-        b.end(toe, v3(0.0, -0.02, 0.06));
-        legs.push((Leg { upper: up, lower: knee, tip: Some(foot), rest_pole: DVec3::Z }, toe, 0.09 * s));
+        let up = b.add(&m(&format!("{side}UpLeg")), 0, v3(0.09 * s * k, -0.06 * k, 0.0));
+        let knee = b.add(&m(&format!("{side}Leg")), up, v3(0.0, -0.43 * leg_k, 0.0));
+        let foot = b.add(&m(&format!("{side}Foot")), knee, v3(0.0, -0.41 * leg_k, 0.0));
+        let toe = b.add(&m(&format!("{side}ToeBase")), foot, v3(0.0, -0.06 * k, 0.12 * k));
+        b.end(toe, v3(0.0, -0.02 * k, 0.06 * k));
+        legs.push((Leg { upper: up, lower: knee, tip: Some(foot), rest_pole: DVec3::Z }, toe, 0.09 * s * k));
     }
-    let skel = b.build();
+    BipedBody { skel: b.build(), spine: [spine, spine1, spine2], neck, head, arms, legs }
+}
+
+/// Mixamo-named human walking: alternating legs, counter-swinging arms, a level head.
+pub(super) fn biped(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    let body = biped_body(&training::proportions("biped", 0).expect("biped exists"));
+    let BipedBody { skel, spine: [spine, spine1, spine2], neck, head, arms, legs } = body;
 
     let (frames, period) = frames_for(rng.vary(1.1, 0.06), 3);
     let gait = Gait { period, duty: rng.vary(0.6, 0.03), stride: rng.vary(1.05, 0.08), lift: rng.vary(0.07, 0.1) };
@@ -132,6 +154,10 @@ struct QuadSpec {
     /// Name of a part; `left` is `None` for centre parts.
     name: fn(Part, Option<bool>) -> String,
     scale: f64,
+    /// Leg and wing bone lengths relative to `scale`.
+    limbs: f64,
+    /// Tail bone lengths relative to `scale`.
+    tail_length: f64,
     spine: usize,
     neck: usize,
     neck_length: f64,
@@ -208,6 +234,8 @@ pub(super) fn quadruped(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         layout: Layout { root_order: "XYZ", joint_order: "XYZ", all_positions: false },
         name: bip01_name,
         scale: 1.0,
+        limbs: 1.0,
+        tail_length: 1.0,
         spine: 3,
         neck: 1,
         neck_length: 0.14,
@@ -230,6 +258,8 @@ pub(super) fn dragon(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         layout: Layout { root_order: "ZXY", joint_order: "YZX", all_positions: false },
         name: rigify_name,
         scale: 2.4,
+        limbs: 1.0,
+        tail_length: 1.0,
         spine: 3,
         neck: 3,
         neck_length: 0.3,
@@ -244,10 +274,28 @@ pub(super) fn dragon(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     four_legged(&spec, rng)
 }
 
-fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
+/// The four-legged body's joints and dimensions, as the gaits need them.
+pub(super) struct QuadBody {
+    pub skel: Skeleton,
+    pub spine: Vec<usize>,
+    pub neck: Vec<usize>,
+    pub head: usize,
+    pub tail: Vec<usize>,
+    /// Three joints per wing, left then right; empty without wings.
+    pub wings: Vec<[usize; 3]>,
+    /// (IK chain, home x, home z, knee pole), in the order LF, RF, LH, RH.
+    pub legs: Vec<(Leg, f64, f64, DVec3)>,
+    pub hip_drop: f64,
+    /// One leg bone (thigh = calf).
+    pub bone: f64,
+    pub ankle_y: f64,
+}
+
+fn quad_body(spec: &QuadSpec) -> QuadBody {
     let k = spec.scale;
     let name = spec.name;
-    let (half_width, hip_drop, bone, ankle_y) = (0.09 * k, 0.07 * k, 0.21 * k, 0.06 * k);
+    let (lk, tk) = (k * spec.limbs, k * spec.tail_length);
+    let (half_width, hip_drop, bone, ankle_y) = (0.09 * k, 0.07 * k, 0.21 * lk, 0.06 * k);
     let body = 0.58 * k;
     let pelvis_y = ankle_y + 2.0 * bone + hip_drop;
     let mut b = Builder::new(&name(Part::Pelvis, None), v3(0.0, pelvis_y, 0.0), spec.layout);
@@ -295,9 +343,9 @@ fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
         for left in [true, false] {
             let s = if left { 1.0 } else { -1.0 };
             let w0 = b.add(&name(Part::Wing(0), Some(left)), chest, v3(0.07 * s * k, 0.05 * k, -0.05 * k));
-            let w1 = b.add(&name(Part::Wing(1), Some(left)), w0, v3(0.35 * s * k, 0.05 * k, -0.05 * k));
-            let w2 = b.add(&name(Part::Wing(2), Some(left)), w1, v3(0.4 * s * k, 0.0, -0.1 * k));
-            b.end(w2, v3(0.45 * s * k, -0.05 * k, -0.3 * k));
+            let w1 = b.add(&name(Part::Wing(1), Some(left)), w0, v3(0.35 * s * lk, 0.05 * lk, -0.05 * lk));
+            let w2 = b.add(&name(Part::Wing(2), Some(left)), w1, v3(0.4 * s * lk, 0.0, -0.1 * lk));
+            b.end(w2, v3(0.45 * s * lk, -0.05 * lk, -0.3 * lk));
             wings.push([w0, w1, w2]);
         }
     }
@@ -308,12 +356,17 @@ fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
     let mut tail = Vec::new();
     parent = 0;
     for i in 0..spec.tail {
-        let off = if i == 0 { v3(0.0, 0.03 * k, -0.08 * k) } else { v3(0.0, 0.0, -0.1 * k) };
+        let off = if i == 0 { v3(0.0, 0.03 * k, -0.08 * k) } else { v3(0.0, 0.0, -0.1 * tk) };
         parent = b.add(&name(Part::Tail(i), None), parent, off);
         tail.push(parent);
     }
-    b.end(parent, v3(0.0, 0.0, -0.1 * k));
-    let skel = b.build();
+    b.end(parent, v3(0.0, 0.0, -0.1 * tk));
+    QuadBody { skel: b.build(), spine, neck, head, tail, wings, legs, hip_drop, bone, ankle_y }
+}
+
+fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    let QuadBody { skel, spine, neck, tail, wings, legs, hip_drop, bone, ankle_y, .. } = quad_body(spec);
+    let k = spec.scale;
     // Leg order in `legs` is LF, RF, LH, RH; the spec's touchdowns are LH, LF, RH, RF.
     let touchdown = [spec.touchdown[1], spec.touchdown[3], spec.touchdown[0], spec.touchdown[2]];
 
@@ -363,4 +416,32 @@ fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
         }
     });
     (skel, motion)
+}
+
+/// The quadruped's or (with `dragon`) the dragon's body scaled by `shape`, for training clips.
+/// Only the body fields of the spec matter here; the gait ones are the training module's.
+pub(super) fn quad_training_body(dragon: bool, shape: &Proportions) -> QuadBody {
+    let gait = Gait { period: 1.0, duty: 0.5, stride: 1.0, lift: 0.1 };
+    let spec = QuadSpec {
+        layout: if dragon {
+            Layout { root_order: "ZXY", joint_order: "YZX", all_positions: false }
+        } else {
+            Layout { root_order: "XYZ", joint_order: "XYZ", all_positions: false }
+        },
+        name: if dragon { rigify_name } else { bip01_name },
+        scale: if dragon { 2.4 } else { 1.0 } * shape.size,
+        limbs: shape.limbs,
+        tail_length: shape.tail,
+        spine: shape.body_joints,
+        neck: shape.neck_joints,
+        neck_length: if dragon { 0.3 } else { 0.14 } * shape.neck,
+        tail: shape.tail_joints,
+        wings: dragon,
+        touchdown: [0.0; 4],
+        gait,
+        cycles: 1,
+        tail_sway: 0.0,
+        wing_flap: 0.0,
+    };
+    quad_body(&spec)
 }

@@ -14,14 +14,29 @@
 //! Layout: this module holds the API and the shared machinery (PRNG, skeleton builder, per-frame
 //! pose solver, IK, gait timing); the creatures live in `legged` (biped, quadruped, dragon),
 //! `arthropod` (spider, centipede, crab), `undulating` (snake, fish) and `bird`.
+//!
+//! The training zoo (`training_clip`, `write_training_zoo`) reuses those bodies with other
+//! proportions and joint counts and gives each family several actions (walk, run, idle, turn,
+//! walk-stop-walk, ...): `training` holds its API, `route` the ground track and foot planning
+//! that let bodies stop and curve, and `legged_actions`, `arthropod_actions` and `body_actions`
+//! the families' actions.
 
 mod arthropod;
+mod arthropod_actions;
 mod bird;
+mod body_actions;
 mod legged;
+mod legged_actions;
+mod route;
+mod training;
 mod undulating;
+
+pub use training::{actions, proportions, training_clip, write_training_zoo, Action, Clip, Proportions, CLIP_FRAMES};
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod training_tests;
 
 use crate::bvh::{self, Bvh, Channel};
 use crate::motion::Motion;

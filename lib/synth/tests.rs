@@ -144,7 +144,7 @@ fn feet_are_found_by_name_and_count_the_legs() {
 
 /// Ground contact points of a creature: every End Site under a named foot, and the foot joint
 /// it hangs from (contact detectors look at joints, which must be still too).
-fn contacts(skel: &Skeleton) -> Vec<(usize, DVec3)> {
+pub(super) fn contacts(skel: &Skeleton) -> Vec<(usize, DVec3)> {
     let (feet, _) = roles::feet(skel);
     let mut out = Vec::new();
     for &j in &feet {
@@ -158,7 +158,7 @@ fn contacts(skel: &Skeleton) -> Vec<(usize, DVec3)> {
 
 /// Per contact: (fraction of frames near the ground, median horizontal speed in those frames,
 /// fastest horizontal speed), all speeds relative to the root's mean speed.
-fn planting(skel: &Skeleton, motion: &Motion) -> Vec<(String, f64, f64, f64)> {
+pub(super) fn planting(skel: &Skeleton, motion: &Motion) -> Vec<(String, f64, f64, f64)> {
     let world = motion.forward_kinematics(skel);
     let n = motion.frames;
     let dt = motion.frame_time;

@@ -44,25 +44,40 @@ impl Serpenoid {
     }
 }
 
+/// The snake's joints: the jaw, and the body chain from the neck to the tail tip.
+pub(super) struct SnakeBody {
+    pub skel: Skeleton,
+    pub radius: f64,
+    pub jaw: usize,
+    pub neck: usize,
+    pub body: Vec<usize>,
+}
+
+/// The snake with `shape.body_joints` spine and `shape.tail_joints` tail joints, scaled by
+/// `shape` (`tail` stretches the vertebrae, `neck` the head and neck).
+pub(super) fn snake_body(shape: &Proportions) -> SnakeBody {
+    let layout = Layout { root_order: "YZX", joint_order: "YZX", all_positions: false };
+    let (k, n, tl) = (shape.size, shape.size * shape.neck, shape.size * shape.tail);
+    let radius = 0.03 * k;
+    let mut b = Builder::new("jtHead", v3(0.0, radius, 0.0), layout);
+    let jaw = b.add("jtJaw", 0, v3(0.0, -0.01 * k, 0.02 * k));
+    b.end(jaw, v3(0.0, 0.0, 0.05 * n));
+    let neck = b.add("jtNeck", 0, v3(0.0, 0.0, -0.06 * n));
+    let spine_names: Vec<String> = (1..=shape.body_joints).map(|i| format!("jtSpine{i:02}")).collect();
+    let mut body = vec![neck];
+    body.extend(b.chain(&spine_names, neck, v3(0.0, 0.0, -0.07 * tl), v3(0.0, 0.0, -0.07 * tl)));
+    let tail_names: Vec<String> = (1..=shape.tail_joints).map(|i| format!("jtTail{i:02}")).collect();
+    let last = *body.last().expect("the neck is there");
+    body.extend(b.chain(&tail_names, last, v3(0.0, 0.0, -0.06 * tl), v3(0.0, 0.0, -0.055 * tl)));
+    b.end(*body.last().expect("the neck is there"), v3(0.0, 0.0, -0.05 * tl));
+    SnakeBody { skel: b.build(), radius, jaw, neck, body }
+}
+
 /// A snake on the ground with its head raised, `jt`-prefixed names. The root is the head, as
 /// in many snake rigs; a root in mid-body would also make the straight rest pose look
 /// mirror-symmetric front to back to the geometric side rule.
 pub(super) fn snake(rng: &mut SplitMix64) -> (Skeleton, Motion) {
-    const SPINE: usize = 16;
-    const TAIL: usize = 6;
-    let layout = Layout { root_order: "YZX", joint_order: "YZX", all_positions: false };
-    let radius = 0.03;
-    let mut b = Builder::new("jtHead", v3(0.0, radius, 0.0), layout);
-    let jaw = b.add("jtJaw", 0, v3(0.0, -0.01, 0.02));
-    b.end(jaw, v3(0.0, 0.0, 0.05));
-    let neck = b.add("jtNeck", 0, v3(0.0, 0.0, -0.06));
-    let spine_names: Vec<String> = (1..=SPINE).map(|i| format!("jtSpine{i:02}")).collect();
-    let mut body = vec![neck];
-    body.extend(b.chain(&spine_names, neck, v3(0.0, 0.0, -0.07), v3(0.0, 0.0, -0.07)));
-    let tail_names: Vec<String> = (1..=TAIL).map(|i| format!("jtTail{i:02}")).collect();
-    body.extend(b.chain(&tail_names, *body.last().unwrap(), v3(0.0, 0.0, -0.06), v3(0.0, 0.0, -0.055)));
-    b.end(*body.last().unwrap(), v3(0.0, 0.0, -0.05));
-    let skel = b.build();
+    let SnakeBody { skel, radius, jaw, neck, body } = snake_body(&training::proportions("snake", 0).expect("snake exists"));
 
     // Arc length of every joint behind the head (the rest pose is straight along -z).
     let rest = skel.rest_positions();
@@ -95,39 +110,67 @@ pub(super) fn snake(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     (skel, motion)
 }
 
-/// A fish swimming in mid-water, snake_case names with `_L`/`_R` fins.
-pub(super) fn fish(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+/// The fish's joints: head, jaw, fins, and the spine chain ending in the tail fin.
+pub(super) struct FishBody {
+    pub skel: Skeleton,
+    pub head: usize,
+    pub jaw: usize,
+    pub fins: Vec<usize>,
+    pub pelvic: Vec<usize>,
+    pub dorsal: usize,
+    /// spine_02 .. tail_fin.
+    pub spine: Vec<usize>,
+    /// Nose to tail tip, for the swimming speed in body lengths.
+    pub length: f64,
+}
+
+/// The fish with `shape.body_joints` spine joints behind the root (at least 3), scaled by
+/// `shape` (`tail` stretches the spine and tail fin, `limbs` the fins).
+pub(super) fn fish_body(shape: &Proportions, depth: f64) -> FishBody {
     let layout = Layout { root_order: "XZY", joint_order: "XZY", all_positions: false };
-    let depth = 0.5;
+    let (k, f, tl) = (shape.size, shape.size * shape.limbs, shape.size * shape.tail);
     let mut b = Builder::new("spine_01", v3(0.0, depth, 0.0), layout);
-    let head = b.add("head", 0, v3(0.0, 0.0, 0.1));
-    let jaw = b.add("jaw", head, v3(0.0, -0.025, 0.04));
-    b.end(jaw, v3(0.0, 0.0, 0.06));
+    let head = b.add("head", 0, v3(0.0, 0.0, 0.1 * k));
+    let jaw = b.add("jaw", head, v3(0.0, -0.025 * k, 0.04 * k));
+    b.end(jaw, v3(0.0, 0.0, 0.06 * k));
     let mut fins = Vec::new();
     for left in [true, false] {
         let s = if left { 1.0 } else { -1.0 };
-        let fin = b.add(if left { "fin_L" } else { "fin_R" }, 0, v3(0.04 * s, -0.03, 0.03));
-        b.end(fin, v3(0.07 * s, -0.02, -0.05));
+        let fin = b.add(if left { "fin_L" } else { "fin_R" }, 0, v3(0.04 * s * k, -0.03 * k, 0.03 * k));
+        b.end(fin, v3(0.07 * s * f, -0.02 * f, -0.05 * f));
         fins.push(fin);
     }
-    let spine2 = b.add("spine_02", 0, v3(0.0, 0.0, -0.1));
-    let dorsal = b.add("dorsal_fin", spine2, v3(0.0, 0.06, 0.0));
-    b.end(dorsal, v3(0.0, 0.06, -0.07));
-    let spine3 = b.add("spine_03", spine2, v3(0.0, 0.0, -0.1));
+    let spine2 = b.add("spine_02", 0, v3(0.0, 0.0, -0.1 * tl));
+    let dorsal = b.add("dorsal_fin", spine2, v3(0.0, 0.06 * k, 0.0));
+    b.end(dorsal, v3(0.0, 0.06 * f, -0.07 * f));
+    let spine3 = b.add("spine_03", spine2, v3(0.0, 0.0, -0.1 * tl));
     let mut pelvic = Vec::new();
     for left in [true, false] {
         let s = if left { 1.0 } else { -1.0 };
-        let fin = b.add(if left { "pelvic_fin_L" } else { "pelvic_fin_R" }, spine3, v3(0.02 * s, -0.05, 0.0));
-        b.end(fin, v3(0.02 * s, -0.04, -0.05));
+        let fin = b.add(if left { "pelvic_fin_L" } else { "pelvic_fin_R" }, spine3, v3(0.02 * s * k, -0.05 * k, 0.0));
+        b.end(fin, v3(0.02 * s * f, -0.04 * f, -0.05 * f));
         pelvic.push(fin);
     }
-    let rest: Vec<String> = (4..=6).map(|i| format!("spine_{i:02}")).collect();
+    // Behind spine_03 the vertebrae shorten from 0.09 to 0.08 as in the example fish (which
+    // has three of them); more or fewer share the same length.
+    let more = shape.body_joints.max(3) - 2;
+    let rest: Vec<String> = (4..4 + more).map(|i| format!("spine_{i:02}")).collect();
     let mut spine = vec![spine2, spine3];
-    spine.extend(b.chain(&rest, spine3, v3(0.0, 0.0, -0.09), v3(0.0, 0.0, -0.08)));
-    let tail = b.add("tail_fin", *spine.last().unwrap(), v3(0.0, 0.0, -0.07));
-    b.end(tail, v3(0.0, 0.0, -0.1));
+    let length_scale = 3.0 / more as f64;
+    let (first, step) = (0.09 * tl * length_scale.sqrt(), 0.08 * tl * length_scale.sqrt());
+    spine.extend(b.chain(&rest, spine3, v3(0.0, 0.0, -first), v3(0.0, 0.0, -step)));
+    let tail = b.add("tail_fin", *spine.last().expect("spine_03 is there"), v3(0.0, 0.0, -0.07 * tl));
+    b.end(tail, v3(0.0, 0.0, -0.1 * tl));
     spine.push(tail);
-    let skel = b.build();
+    let length = 0.16 * k + 0.2 * tl + first + step * (more - 1) as f64 + 0.17 * tl;
+    FishBody { skel: b.build(), head, jaw, fins, pelvic, dorsal, spine, length }
+}
+
+/// A fish swimming in mid-water, snake_case names with `_L`/`_R` fins.
+pub(super) fn fish(rng: &mut SplitMix64) -> (Skeleton, Motion) {
+    let depth = 0.5;
+    let FishBody { skel, head, jaw, fins, pelvic, dorsal, spine, .. } =
+        fish_body(&training::proportions("fish", 0).expect("fish exists"), depth);
 
     let beat = rng.vary(0.4, 0.08);
     let (frames, period) = frames_for(beat, 8);
