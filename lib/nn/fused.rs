@@ -181,25 +181,35 @@ impl Attention {
                 }
                 Keys::Window { frame_ok, .. } => {
                     let tokens_ok = &frame_ok[sample * n..(sample + 1) * n];
-                    for (k, v) in row.iter_mut().enumerate() {
-                        if !(((lo..hi).contains(&k) || k == 0) && tokens_ok[k]) {
-                            *v = f32::NEG_INFINITY;
+                    for k in (lo..hi).chain((lo > 0).then_some(0)) {
+                        if !tokens_ok[k] {
+                            row[k] = f32::NEG_INFINITY;
                         }
                     }
                 }
             }
-            let max = row.iter().fold(f32::NEG_INFINITY, |m, &v| m.max(v));
+            // Only the span (and key 0) can be visible: everything else stays 0, which saves
+            // the exponentials and value rows of the 90 keys outside a 31-frame window when
+            // sampling 120 frames.
+            let max = row[lo..hi].iter().fold(if lo > 0 { row[0] } else { f32::NEG_INFINITY }, |m, &v| m.max(v));
             if max == f32::NEG_INFINITY {
                 row.fill(0.0);
                 continue;
             }
             let mut sum = 0.0;
-            for v in row.iter_mut() {
+            for v in row[lo..hi].iter_mut() {
                 *v = (*v - max).exp();
                 sum += *v;
             }
+            if lo > 0 {
+                row[0] = (row[0] - max).exp();
+                sum += row[0];
+            }
             let inv = 1.0 / sum;
-            row.iter_mut().for_each(|v| *v *= inv);
+            row[lo..hi].iter_mut().for_each(|v| *v *= inv);
+            if lo > 0 {
+                row[0] *= inv;
+            }
         }
     }
 
@@ -233,10 +243,13 @@ impl Attention {
                 for i in 0..n {
                     let yi = s.rows[i] * w + h * dh;
                     let out = &mut y[yi..yi + dh];
-                    for (k, &pk) in s.p[i * n..(i + 1) * n].iter().enumerate() {
-                        if pk != 0.0 {
-                            out.iter_mut().zip(&s.v[k * dh..(k + 1) * dh]).for_each(|(o, v)| *o += pk * v);
-                        }
+                    let (lo, hi) = self.span(i);
+                    let prow = &s.p[i * n..(i + 1) * n];
+                    // y_i[e] = sum_k P_ik v_k[e]: a dot product over the visible keys per head
+                    // dimension, on the transposed values (long contiguous runs, not dh-long ones).
+                    for (e, o) in out.iter_mut().enumerate() {
+                        let vt = &s.vt[e * n..(e + 1) * n];
+                        *o = dot(&prow[lo..hi], &vt[lo..hi]) + if lo > 0 { prow[0] * vt[0] } else { 0.0 };
                     }
                 }
             }
@@ -345,6 +358,21 @@ impl Attention {
         }
         (dqkv, dc)
     }
+}
+
+/// `a · b` with eight independent partial sums, which the compiler keeps in one vector
+/// register (a plain running sum has to stay in order and cannot be vectorised).
+#[inline(always)]
+fn dot(a: &[f32], b: &[f32]) -> f32 {
+    let mut acc = [0f32; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f32 = ca.remainder().iter().zip(cb.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in ca.zip(cb) {
+        for l in 0..8 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    acc.iter().sum::<f32>() + tail
 }
 
 /// Per-(group, head) buffers, reused across groups.
