@@ -67,13 +67,17 @@ pub enum Keys {
 pub const NO_TYPE: u16 = u16::MAX;
 
 /// The attention problem: shapes, heads, scale and masks.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 struct Attention {
     groups: Groups,
     heads: usize,
     head_dim: usize,
     scale: f32,
     keys: Keys,
+    /// When the result takes part in a backward pass, the forward keeps every (group, head)
+    /// probability block here (`groups x heads x len x len`) so the backward need not
+    /// recompute them: the exponentials were a third of its time. Sampling keeps nothing.
+    saved: Option<std::sync::Mutex<Vec<f32>>>,
 }
 
 fn f32_slice<'a>(s: &'a CpuStorage, l: &Layout, what: &str) -> Result<&'a [f32]> {
@@ -232,6 +236,11 @@ impl Attention {
 
     #[inline(always)]
     fn forward_body(&self, qkv: &[f32], c: Option<&[f32]>) -> Vec<f32> {
+        let mut saved = self.saved.as_ref().map(|m| m.lock().unwrap_or_else(|e| e.into_inner()));
+        if let Some(buf) = saved.as_mut() {
+            buf.clear();
+            buf.resize(self.groups.groups * self.heads * self.groups.len * self.groups.len, 0.0);
+        }
         let (n, dh, w) = (self.groups.len, self.head_dim, self.width());
         let mut y = vec![0f32; self.groups.rows() * w];
         let mut s = Scratch::new(n, dh);
@@ -240,6 +249,9 @@ impl Attention {
             for h in 0..self.heads {
                 self.gather(qkv, h, &mut s);
                 self.probabilities(c, g, h, &mut s);
+                if let Some(buf) = saved.as_mut() {
+                    buf[(g * self.heads + h) * n * n..(g * self.heads + h + 1) * n * n].copy_from_slice(&s.p);
+                }
                 for i in 0..n {
                     let yi = s.rows[i] * w + h * dh;
                     let out = &mut y[yi..yi + dh];
@@ -280,6 +292,7 @@ impl Attention {
 
     #[inline(always)]
     fn backward_body(&self, qkv: &[f32], c: Option<&[f32]>, dy: &[f32]) -> (Vec<f32>, Option<Vec<f32>>) {
+        let saved = self.saved.as_ref().map(|m| m.lock().unwrap_or_else(|e| e.into_inner()));
         let (n, dh, w) = (self.groups.len, self.head_dim, self.width());
         let mut dqkv = vec![0f32; qkv.len()];
         let mut dc = c.map(|c| vec![0f32; c.len()]);
@@ -294,7 +307,10 @@ impl Attention {
             s.fill_rows(&self.groups, g);
             for h in 0..self.heads {
                 self.gather(qkv, h, &mut s);
-                self.probabilities(c, g, h, &mut s);
+                match saved.as_ref().filter(|b| b.len() == self.groups.groups * self.heads * n * n) {
+                    Some(buf) => s.p.copy_from_slice(&buf[(g * self.heads + h) * n * n..(g * self.heads + h + 1) * n * n]),
+                    None => self.probabilities(c, g, h, &mut s),
+                }
                 for i in 0..n {
                     let r = s.rows[i] * w + h * dh;
                     dyg[i * dh..(i + 1) * dh].copy_from_slice(&dy[r..r + dh]);
@@ -447,7 +463,9 @@ pub fn attention(qkv: &Tensor, bias: Option<&Tensor>, groups: Groups, heads: usi
         candle_core::bail!("fused attention: q/k/v is {rows} x {w3}, expected {} rows and a multiple of {}", groups.rows(), 3 * heads);
     }
     let head_dim = w3 / 3 / heads;
-    let att = Attention { groups, heads, head_dim, scale: 1.0 / (head_dim as f32).sqrt(), keys };
+    let tracked = qkv.track_op() || bias.is_some_and(|b| b.track_op());
+    let saved = tracked.then(|| std::sync::Mutex::new(Vec::new()));
+    let att = Attention { groups, heads, head_dim, scale: 1.0 / (head_dim as f32).sqrt(), keys, saved };
     let qkv = qkv.contiguous()?;
     match (&att.keys, bias) {
         (Keys::Topology { .. }, Some(c)) => qkv.apply_op2(&c.contiguous()?, att),
