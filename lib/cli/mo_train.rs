@@ -268,6 +268,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         set.skeletons.iter().flat_map(|s| &s.clips).map(|c| c.frames).sum::<usize>(),
         set.variant_count()
     ));
+    for v in &set.skipped_variants {
+        say(format!("augmented variant left out: {v}"));
+    }
     if args.common.verbose {
         for v in set.augmented.iter().flatten() {
             say(format!("variant {}: {} joints, {} clips", v.name, v.skeleton.len(), v.clips.len()));

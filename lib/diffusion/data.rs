@@ -99,6 +99,8 @@ pub struct TrainSet {
     pub augmented: Vec<Vec<SkeletonData>>,
     /// Chance that a draw uses an augmented variant (when its skeleton has any).
     pub augment_probability: f64,
+    /// Augmented variants that could not be prepared, with the reason.
+    pub skipped_variants: Vec<String>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -240,8 +242,10 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
 
 /// The augmented variants of one skeleton (group `index` of the set): variant `v` removes
 /// joints (`v` even) or subdivides one bone (`v` odd) and carries the frames `deal` gives it.
-/// Variants whose edit changes nothing, or whose clips are all too short, are left out.
-fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawClip, aug: &Augmentation, names: &NameTable, dmax: usize) -> Result<Vec<SkeletonData>, DataError> {
+/// Variants whose edit changes nothing, or whose clips are all too short, are left out; so are
+/// variants that cannot be prepared (their reason goes to `skipped`): an augmentation is never
+/// worth failing a training run for.
+fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawClip, aug: &Augmentation, names: &NameTable, dmax: usize, skipped: &mut Vec<String>) -> Vec<SkeletonData> {
     let mut out = Vec::new();
     for v in 0..aug.variants {
         // One stream per (seed, skeleton, variant): adding a skeleton or a variant leaves the
@@ -265,11 +269,14 @@ fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawC
             (clip.name.clone(), Cow::Owned(motion))
         });
         let mut ignored = Vec::new();
-        if let Some(data) = prepare(format!("{}__{tag}_v{v}", base.name), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, names, dmax, &mut ignored)? {
-            out.push(data);
+        let name = format!("{}__{tag}_v{v}", base.name);
+        match prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, names, dmax, &mut ignored) {
+            Ok(Some(data)) => out.push(data),
+            Ok(None) => {}
+            Err(e) => skipped.push(format!("{name}: {e}")),
         }
     }
-    Ok(out)
+    out
 }
 
 impl TrainSet {
@@ -293,6 +300,7 @@ impl TrainSet {
         let mut skeletons = Vec::with_capacity(groups.len());
         let mut augmented = Vec::with_capacity(groups.len());
         let mut dropped = Vec::new();
+        let mut skipped_variants = Vec::new();
         for (index, (group, name)) in groups.into_iter().zip(group_names).enumerate() {
             let rest = group.iter().find(|c| anytop::names_tpose(&c.name)).unwrap_or(&group[0]);
             let skeleton = group[0].skeleton.clone();
@@ -300,10 +308,12 @@ impl TrainSet {
             let Some(data) = prepare(name, skeleton, (&rest.name, &rest.motion), clips, names, dmax, &mut dropped)? else {
                 return Err(DataError::TooShort { clip: group[0].name.clone() });
             };
-            augmented.push(variants_of(index, &data, &group, rest, aug, names, dmax)?);
+            // Variants nobody will draw are not worth their memory.
+            let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
+            augmented.push(variants_of(index, &data, &group, rest, &wanted, names, dmax, &mut skipped_variants));
             skeletons.push(data);
         }
-        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability }, dropped))
+        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants }, dropped))
     }
 
     /// The skeleton (original or augmented variant) a crop comes from.
@@ -506,6 +516,8 @@ mod tests {
         assert!((p - 2.0 / 3.0).abs() < 0.08, "{p}");
         set.augment_probability = 0.0;
         assert_eq!(share(&set), 0.0);
+        let off = Augmentation { probability: 0.0, ..aug };
+        assert_eq!(TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &off).unwrap().0.variant_count(), 0, "probability 0: no variants built");
         set.augment_probability = 1.0;
         assert_eq!(share(&set), 1.0);
         aug.probability = 1.5;
