@@ -138,7 +138,8 @@ fn stem_of(name: &str) -> String {
 
 /// A readable name per group: the folder's name when the group is the only skeleton of its
 /// folder, else the stem its clips' file names share (`biped_long_walk`, `biped_long_run` ->
-/// `biped_long`), else its first clip's stem; made unique with `_2`, `_3`, ...
+/// `biped_long`) when no other group's files share it, else its first clip's stem; made
+/// unique with `_2`, `_3`, ...
 fn group_names(groups: &[Vec<RawClip>]) -> Vec<String> {
     let folders: Vec<Vec<String>> = groups.iter().map(|g| g.iter().map(|c| folder_of(&c.name)).collect()).collect();
     let mut names = Vec::with_capacity(groups.len());
@@ -156,7 +157,9 @@ fn group_names(groups: &[Vec<RawClip>]) -> Vec<String> {
                 prefix = prefix.chars().take(common).collect();
             }
             let prefix = prefix.trim_end_matches(|c: char| c == '_' || c == '-' || c == '.' || c == ' ').to_string();
-            if prefix.chars().count() >= 2 { prefix } else { stems[0].clone() }
+            // A prefix that other groups' files share too (`dataset-1_...`) says nothing.
+            let distinctive = prefix.chars().count() >= 2 && groups.iter().enumerate().all(|(k, g)| k == i || g.iter().all(|c| !stem_of(&c.name).starts_with(&prefix)));
+            if distinctive { prefix } else { stems[0].clone() }
         };
         let mut unique = name.clone();
         let mut k = 2;
@@ -260,11 +263,16 @@ fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawC
         if plan.is_empty() {
             continue;
         }
-        let pieces = deal(group.iter().map(|c| c.motion.frames).collect::<Vec<_>>().as_slice(), v, aug.variants);
+        // Only croppable clips are dealt (a T-pose file would leave its variant without any).
+        let usable: Vec<&RawClip> = group.iter().filter(|c| c.motion.frames > MIN_FRAMES + 1).collect();
+        if usable.is_empty() {
+            continue;
+        }
+        let pieces = deal(&usable.iter().map(|c| c.motion.frames).collect::<Vec<_>>(), v, aug.variants);
         let tag = if v % 2 == 0 { format!("remove{}", plan.joints_before - plan.skeleton.len()) } else { "add1".to_string() };
         let rest_motion = plan.apply_motion(&base.skeleton, &rest.motion.first_frames(2));
         let clips = pieces.into_iter().map(|(c, range)| {
-            let clip = &group[c];
+            let clip = usable[c];
             let motion = if range == (0..clip.motion.frames) { plan.apply_motion(&base.skeleton, &clip.motion) } else { plan.apply_motion(&base.skeleton, &clip.motion.frame_range(range.start, range.end)) };
             (clip.name.clone(), Cow::Owned(motion))
         });
@@ -406,7 +414,7 @@ mod tests {
         vec![
             RawClip { name: "zoo/quad_walk.bvh".into(), skeleton, motion: motion.clone() },
             RawClip { name: "zoo/quad_run.bvh".into(), skeleton: nudged, motion: motion.clone() },
-            RawClip { name: "zoo/quadlong_walk.bvh".into(), skeleton: long, motion: long_motion },
+            RawClip { name: "zoo/long_quad_walk.bvh".into(), skeleton: long, motion: long_motion },
         ]
     }
 
@@ -439,8 +447,13 @@ mod tests {
         let (set, _) = TrainSet::build(proportions(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
         let got: Vec<(&str, usize)> = set.skeletons.iter().map(|s| (s.name.as_str(), s.clips.len())).collect();
         // Two skeletons share the folder, so they are named by what their file names share.
-        assert_eq!(got, vec![("quad", 2), ("quadlong_walk", 1)]);
+        assert_eq!(got, vec![("quad", 2), ("long_quad_walk", 1)]);
         assert_ne!(set.skeletons[0].rest_row, set.skeletons[1].rest_row, "each proportion has its own rest pose");
+        // A prefix other groups' files share is no name: the first clip's stem instead.
+        let mut clips = proportions();
+        clips[2].name = "zoo/quad_long_walk.bvh".into();
+        let (set, _) = TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        assert_eq!(set.skeletons.iter().map(|s| s.name.as_str()).collect::<Vec<_>>(), ["quad_walk", "quad_long_walk"]);
         // One skeleton per folder: the folder names it.
         let (set, _) = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
         let folders: Vec<&str> = set.skeletons.iter().map(|s| s.name.as_str()).collect();
