@@ -156,7 +156,7 @@ fn group_names(groups: &[Vec<RawClip>]) -> Vec<String> {
                 let common = prefix.chars().zip(s.chars()).take_while(|(a, b)| a == b).count();
                 prefix = prefix.chars().take(common).collect();
             }
-            let prefix = prefix.trim_end_matches(|c: char| c == '_' || c == '-' || c == '.' || c == ' ').to_string();
+            let prefix = prefix.trim_end_matches(['_', '-', '.', ' ']).to_string();
             // A prefix that other groups' files share too (`dataset-1_...`) says nothing.
             let distinctive = prefix.chars().count() >= 2 && groups.iter().enumerate().all(|(k, g)| k == i || g.iter().all(|c| !stem_of(&c.name).starts_with(&prefix)));
             if distinctive { prefix } else { stems[0].clone() }
@@ -246,10 +246,10 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
 /// The augmented variants of one skeleton (group `index` of the set): variant `v` removes
 /// joints (`v` even) or subdivides one bone (`v` odd) and carries the frames `deal` gives it.
 /// Variants whose edit changes nothing, or whose clips are all too short, are left out; so are
-/// variants that cannot be prepared (their reason goes to `skipped`): an augmentation is never
+/// variants that cannot be prepared (returned with the reason): an augmentation is never
 /// worth failing a training run for.
-fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawClip, aug: &Augmentation, names: &NameTable, dmax: usize, skipped: &mut Vec<String>) -> Vec<SkeletonData> {
-    let mut out = Vec::new();
+fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawClip, aug: &Augmentation, names: &NameTable, dmax: usize) -> (Vec<SkeletonData>, Vec<String>) {
+    let (mut out, mut skipped) = (Vec::new(), Vec::new());
     for v in 0..aug.variants {
         // One stream per (seed, skeleton, variant): adding a skeleton or a variant leaves the
         // others' edits as they were.
@@ -284,7 +284,7 @@ fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawC
             Err(e) => skipped.push(format!("{name}: {e}")),
         }
     }
-    out
+    (out, skipped)
 }
 
 impl TrainSet {
@@ -318,7 +318,9 @@ impl TrainSet {
             };
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
-            augmented.push(variants_of(index, &data, &group, rest, &wanted, names, dmax, &mut skipped_variants));
+            let (variants, skipped) = variants_of(index, &data, &group, rest, &wanted, names, dmax);
+            augmented.push(variants);
+            skipped_variants.extend(skipped);
             skeletons.push(data);
         }
         Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants }, dropped))
