@@ -309,12 +309,16 @@ impl TrainSet {
         let mut augmented = Vec::with_capacity(groups.len());
         let mut dropped = Vec::new();
         let mut skipped_variants = Vec::new();
+        let mut first_short = None;
         for (index, (group, name)) in groups.into_iter().zip(group_names).enumerate() {
             let rest = group.iter().find(|c| anytop::names_tpose(&c.name)).unwrap_or(&group[0]);
             let skeleton = group[0].skeleton.clone();
             let clips = group.iter().map(|c| (c.name.clone(), Cow::Borrowed(&c.motion)));
+            // A skeleton with no croppable clip (a lone bind-pose file) is left out, its clips
+            // reported as dropped; only a set with nothing left is an error.
             let Some(data) = prepare(name, skeleton, (&rest.name, &rest.motion), clips, names, dmax, &mut dropped)? else {
-                return Err(DataError::TooShort { clip: group[0].name.clone() });
+                first_short.get_or_insert_with(|| group[0].name.clone());
+                continue;
             };
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
@@ -322,6 +326,9 @@ impl TrainSet {
             augmented.push(variants);
             skipped_variants.extend(skipped);
             skeletons.push(data);
+        }
+        if skeletons.is_empty() {
+            return Err(DataError::TooShort { clip: first_short.unwrap_or_default() });
         }
         Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants }, dropped))
     }
@@ -423,8 +430,16 @@ mod tests {
     #[test]
     fn clips_group_by_skeleton_and_normalise() {
         let names = NameTable::builtin().unwrap();
-        let (set, dropped) = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
-        assert!(dropped.is_empty());
+        // A skeleton whose only clip is too short is left out, not an error.
+        let mut clips = zoo();
+        let (skeleton, motion) = synth::creature("crab", 0).unwrap();
+        clips.push(RawClip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) });
+        let (set, dropped) = TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        assert_eq!(dropped, ["crab/bind.bvh"]);
+        assert!(set.skeletons.iter().all(|s| s.name != "crab"));
+        let (skeleton, motion) = synth::creature("crab", 0).unwrap();
+        let short = vec![RawClip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) }];
+        assert!(matches!(TrainSet::build(short, names, topology::DEFAULT_DMAX, &Augmentation::none()), Err(DataError::TooShort { .. })));
         assert_eq!(set.skeletons.iter().map(|s| s.clips.len()).sum::<usize>(), 6);
         assert_eq!(set.variant_count(), 0);
         for s in &set.skeletons {
