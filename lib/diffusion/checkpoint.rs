@@ -127,3 +127,31 @@ pub fn load_optimizer(dir: &Path, info: &CheckpointInfo, device: &Device, lr: f6
     opt.load_state(&tensors, info.step);
     Ok(opt)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn find_trained_prefers_the_nearest_proportions() {
+        let (skeleton, _) = crate::synth::creature("quadruped", 0).unwrap();
+        let trained = |name: &str, scale: f64| TrainedSkeleton {
+            name: name.into(),
+            joints: skeleton.joints.iter().map(|j| j.name.clone()).collect(),
+            parents: skeleton.parents(),
+            stats: AnyTopStats { mean: vec![0.0; skeleton.len() * 13], std: vec![1.0; skeleton.len() * 13] },
+            clips: 1,
+            offsets: skeleton.joints.iter().map(|j| (j.offset * scale).to_array()).collect(),
+        };
+        let list = [trained("long", 1.3), trained("plain", 1.0), trained("short", 0.8)];
+        assert_eq!(find_trained(&list, &skeleton).map(|t| t.name.as_str()), Some("plain"));
+        let mut longer = skeleton.clone();
+        longer.joints.iter_mut().for_each(|j| j.offset *= 1.25);
+        assert_eq!(find_trained(&list, &longer).map(|t| t.name.as_str()), Some("long"));
+        // Older checkpoints record no offsets: names and parents decide.
+        let old = [TrainedSkeleton { offsets: Vec::new(), ..trained("old", 1.0) }];
+        assert_eq!(find_trained(&old, &longer).map(|t| t.name.as_str()), Some("old"));
+        let (crab, _) = crate::synth::creature("crab", 0).unwrap();
+        assert!(find_trained(&list, &crab).is_none());
+    }
+}
