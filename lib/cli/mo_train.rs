@@ -43,8 +43,9 @@ EXAMPLES:
 /// Skeletal augmentation (AnyTop appendix C): before training, --augment-variants edited
 /// copies of every skeleton are prepared, alternately with 10-30% of the joints removed (whole
 /// end-effector chains, never feet) and with one bone subdivided, each with its own rest pose,
-/// statistics, topology and names; every clip of a skeleton is re-encoded for one of its
-/// variants. A draw then uses one of the variants with probability --augment (default 2/3:
+/// statistics, topology and names. Each clip (or, when a skeleton has fewer clips than
+/// variants, a piece of one) is re-encoded for one variant only, so feature memory at most
+/// about doubles. A draw then uses one of the variants with probability --augment (default 2/3:
 /// the reference picks none / remove / add uniformly). --augment 0 turns it off.
 ///
 /// Checkpoints go to --out (model.safetensors, optimizer.safetensors, checkpoint.json) every
