@@ -1,7 +1,8 @@
 use clap::Parser;
-use menagerie::cli::{finish, mo_train};
+use menagerie::cli::mo_train;
 
 fn main() -> std::process::ExitCode {
     let args = mo_train::Args::parse();
-    finish("mo-train", mo_train::run(&args))
+    // Not `cli::finish`: an interrupted run exits 130, not 2.
+    mo_train::main(&args)
 }

@@ -6,7 +6,9 @@ complete -c mo-train -l steps -d 'Training steps in total (a resumed run counts 
 complete -c mo-train -l batch -d 'Crops per step' -r
 complete -c mo-train -l crop -d 'Crop length in frames' -r
 complete -c mo-train -l lr -d 'Learning rate' -r
-complete -c mo-train -l lambda-geo -d 'Weight of the rotation loss (1 - cos of the angle between predicted and true joint rotations) next to the MSE; the reference trains with 1' -r
+complete -c mo-train -l lambda-geo -d 'Weight of the geodesic rotation loss (the angle, in radians, between predicted and true joint rotations) next to the MSE; the reference trains with 1' -r
+complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3' -r
+complete -c mo-train -l augment-variants -d 'Augmented variants prepared per skeleton (alternately removing and adding joints)' -r
 complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this often' -r
 complete -c mo-train -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-train -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r

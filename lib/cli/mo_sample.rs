@@ -94,7 +94,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => args.frames as usize,
     };
 
-    let stats = match loaded.info.skeletons.iter().find(|t| t.matches(skeleton)) {
+    let stats = match checkpoint::find_trained(&loaded.info.skeletons, skeleton) {
         Some(t) => t.stats.clone(),
         None => match &section.stats {
             Some(s) => s.clone(),

@@ -3,7 +3,7 @@
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint::{self, CheckpointInfo, TrainedSkeleton};
-use crate::diffusion::data::{RawClip, TrainSet};
+use crate::diffusion::data::{Augmentation, RawClip, TrainSet};
 use crate::diffusion::train::{named_vars, train_step, AdamW};
 use crate::diffusion::Schedule;
 use crate::embed::NameTable;
@@ -15,26 +15,45 @@ use candle_core::Device;
 use candle_nn::VarMap;
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 const EXAMPLES: &str = "\
 EXAMPLES:
     mo-train examples/data --out model --preset tiny --steps 3 --batch 2 --crop 16
-    mo-train examples/data --out model --preset tiny --steps 5 --batch 2 --crop 16 --resume";
+    mo-train examples/data --out model --preset tiny --steps 5 --batch 2 --crop 16 --resume
+    mo-train examples/data --out model2 --preset tiny --steps 3 --batch 2 --crop 16 --augment 0";
 
 /// Train the diffusion model (AnyTop's denoiser) on BVH clips of any skeletons.
 ///
-/// DATA are BVH files or directories of them. Clips are grouped by skeleton (same joint names
-/// and parents); each skeleton gets its AnyTop rig (rest pose from a T-pose file if one is
-/// named so, else its first clip), its own normalisation statistics, topology (R, D) and
-/// joint-name embeddings. Training draws --batch crops of --crop frames per step, every
-/// skeleton equally often, noises them at a random step of the cosine schedule (T = 100) and
-/// teaches the model to predict the clean motion (masked MSE plus --lambda-geo x a rotation
-/// distance), with AdamW.
+/// DATA are BVH files or directories of them. Clips are grouped by skeleton: same joint names
+/// and parents and the same proportions (rest offsets within 0.1% of the body's size), so
+/// proportion variants of one rig train as separate skeletons. A group is named after its
+/// folder when it is the folder's only skeleton, else after its clips' common file-name stem.
+/// Each skeleton gets its AnyTop rig (rest pose from a T-pose file if one is named so, else its
+/// first clip), its own normalisation statistics, topology (R, D) and joint-name embeddings.
+///
+/// Training draws --batch crops of --crop frames per step, every skeleton equally often,
+/// noises them at a random step of the cosine schedule (T = 100) and teaches the model to
+/// predict the clean motion, with AdamW. The loss is the masked MSE of the normalised features
+/// plus --lambda-geo x the geodesic angle (radians, arccos((tr(R'^T R) - 1) / 2), clamped as
+/// the reference) between predicted and true joint rotations.
+///
+/// Skeletal augmentation (AnyTop appendix C): before training, --augment-variants edited
+/// copies of every skeleton are prepared, alternately with 10-30% of the joints removed (whole
+/// end-effector chains, never feet) and with one bone subdivided, each with its own rest pose,
+/// statistics, topology and names. Each clip (or, when a skeleton has fewer clips than
+/// variants, a piece of one) is re-encoded for one variant only, so feature memory at most
+/// about doubles. A draw then uses one of the variants with probability --augment (default 2/3:
+/// the reference picks none / remove / add uniformly). --augment 0 turns it off.
 ///
 /// Checkpoints go to --out (model.safetensors, optimizer.safetensors, checkpoint.json) every
 /// --checkpoint-minutes and at the end; --resume continues from the one there, exactly as the
-/// run would have gone on. A JSON-lines log (step, loss, steps/s) is appended to OUT/log.jsonl.
+/// run would have gone on. Ctrl-C (or SIGTERM) stops at the end of the current step, saves a
+/// checkpoint and exits with code 130; a second Ctrl-C quits at once (the last checkpoint
+/// stays whole). A JSON-lines log (step, loss, steps/s) is appended to OUT/log.jsonl. On a
+/// terminal a progress bar shows loss, steps/s and ETA; otherwise a line every 50 steps.
 /// The same data, flags and --seed give the same run.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-train", version, after_long_help = EXAMPLES)]
@@ -60,10 +79,17 @@ pub struct Args {
     /// Learning rate.
     #[arg(long, value_name = "LR", default_value_t = 1e-4)]
     pub lr: f64,
-    /// Weight of the rotation loss (1 - cos of the angle between predicted and true joint
-    /// rotations) next to the MSE; the reference trains with 1.
+    /// Weight of the geodesic rotation loss (the angle, in radians, between predicted and true
+    /// joint rotations) next to the MSE; the reference trains with 1.
     #[arg(long, value_name = "W", default_value_t = 1.0)]
     pub lambda_geo: f64,
+    /// Chance that a training draw uses an augmented skeleton (joints removed or added), as a
+    /// number in [0, 1] or a fraction like 2/3.
+    #[arg(long, value_name = "P", default_value = "2/3", value_parser = parse_probability)]
+    pub augment: f64,
+    /// Augmented variants prepared per skeleton (alternately removing and adding joints).
+    #[arg(long, value_name = "N", default_value_t = Augmentation::DEFAULT_VARIANTS as u64, value_parser = clap::value_parser!(u64).range(0..=64))]
+    pub augment_variants: u64,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0)]
     pub checkpoint_minutes: f64,
@@ -72,6 +98,22 @@ pub struct Args {
     pub resume: bool,
     #[command(flatten)]
     pub common: CommonOpts,
+}
+
+/// A probability: a decimal in [0, 1] or a fraction `a/b`.
+fn parse_probability(text: &str) -> Result<f64, String> {
+    let value = match text.split_once('/') {
+        Some((a, b)) => {
+            let (a, b): (f64, f64) = (a.trim().parse().map_err(|_| format!("'{text}' is not a fraction"))?, b.trim().parse().map_err(|_| format!("'{text}' is not a fraction"))?);
+            a / b
+        }
+        None => text.trim().parse().map_err(|_| format!("'{text}' is not a number"))?,
+    };
+    if (0.0..=1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("expected a probability in [0, 1], found {text}"))
+    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,40 +133,97 @@ impl Preset {
     }
 }
 
+/// The training ended on Ctrl-C or SIGTERM, after saving a checkpoint.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted at step {step}, checkpoint saved; --resume to continue")]
+pub struct Interrupted {
+    pub step: u64,
+}
+
+/// Exit code after an interruption (128 + SIGINT, what shells report for Ctrl-C).
+pub const INTERRUPTED_EXIT: u8 = 130;
+
+/// `run`, then the exit code: 130 after Ctrl-C, else as `cli::finish`.
+pub fn main(args: &Args) -> std::process::ExitCode {
+    match run(args) {
+        Err(e) if e.is::<Interrupted>() => {
+            eprintln!("mo-train: {e}");
+            std::process::ExitCode::from(INTERRUPTED_EXIT)
+        }
+        result => crate::cli::finish("mo-train", result),
+    }
+}
+
+/// Set by Ctrl-C / SIGTERM; `SAVING` while a checkpoint is being written.
+static STOP: AtomicBool = AtomicBool::new(false);
+static SAVING: AtomicBool = AtomicBool::new(false);
+
+/// Install the signal handler once per process: the first signal asks the loop to stop at
+/// the next step boundary; a second one quits at once unless a checkpoint is being written
+/// (then the save finishes and the loop stops).
+fn catch_interrupts() -> anyhow::Result<()> {
+    static INSTALLED: OnceLock<Result<(), String>> = OnceLock::new();
+    let installed = INSTALLED.get_or_init(|| {
+        ctrlc::set_handler(|| {
+            if STOP.swap(true, Ordering::SeqCst) && !SAVING.load(Ordering::SeqCst) {
+                eprintln!("\nmo-train: interrupted twice, quitting without saving (the last checkpoint is whole)");
+                std::process::exit(INTERRUPTED_EXIT as i32);
+            }
+        })
+        .map_err(|e| e.to_string())
+    });
+    STOP.store(false, Ordering::SeqCst);
+    installed.clone().map_err(|e| anyhow::anyhow!("cannot catch Ctrl-C: {e}"))
+}
+
+fn save(dir: &std::path::Path, info: &CheckpointInfo, varmap: &VarMap, opt: &AdamW) -> anyhow::Result<()> {
+    SAVING.store(true, Ordering::SeqCst);
+    let result = checkpoint::save(dir, info, varmap, opt);
+    SAVING.store(false, Ordering::SeqCst);
+    result
+}
+
+/// Seconds as `1h02m`, `3m05s` or `42s`.
+fn duration(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        return "?".into();
+    }
+    let s = seconds.max(0.0).round() as u64;
+    match s {
+        0..=59 => format!("{s}s"),
+        60..=3599 => format!("{}m{:02}s", s / 60, s % 60),
+        _ => format!("{}h{:02}m", s / 3600, (s % 3600) / 60),
+    }
+}
+
+/// `[######..............]` for `done` of `total`, `width` cells inside the brackets.
+fn bar(done: u64, total: u64, width: usize) -> String {
+    let filled = if total == 0 { width } else { ((done.min(total) as u128 * width as u128) / total as u128) as usize };
+    format!("[{}{}]", "#".repeat(filled), ".".repeat(width - filled))
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
     crate::nn::keep_freed_memory();
     if !(args.lr.is_finite() && args.lr > 0.0) {
         bail!("--lr must be a positive number, found {}", args.lr);
     }
-    let files = expand_inputs(&args.data)?;
-    let loaded = load_motions(&files, &LoadOptions::default())?;
-    let clips: Vec<RawClip> = loaded.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
-    let names = NameTable::builtin().context("the built-in joint-name table")?;
-    let dmax = topology::DEFAULT_DMAX;
-    let (set, dropped) = TrainSet::build(clips, names, dmax)?;
     let say = |msg: String| {
         if !args.common.quiet {
             eprintln!("mo-train: {msg}");
         }
     };
-    for d in &dropped {
-        say(format!("{d}: too short to crop, left out"));
-    }
-    say(format!(
-        "{} skeletons, {} clips, {} feature frames",
-        set.skeletons.len(),
-        set.skeletons.iter().map(|s| s.clips.len()).sum::<usize>(),
-        set.skeletons.iter().flat_map(|s| &s.clips).map(|c| c.frames).sum::<usize>()
-    ));
-
     let device = Device::Cpu;
     let schedule = Schedule::cosine(100);
+    let dmax = topology::DEFAULT_DMAX;
+    // The checkpoint first: a resumed run must rebuild the data (augmented variants included)
+    // from the seed the run started with.
     let (varmap, model, mut opt, mut info) = if args.resume {
         let loaded = checkpoint::load(&args.out, &device)?;
         let opt = checkpoint::load_optimizer(&args.out, &loaded.info, &device, args.lr)?;
-        if loaded.info.batch as u64 != args.batch || loaded.info.crop as u64 != args.crop || loaded.info.seed != args.common.seed {
-            say("note: --batch, --crop or --seed differ from the checkpoint's; the resumed run is not the one it would have been".into());
+        let i = &loaded.info;
+        if i.batch as u64 != args.batch || i.crop as u64 != args.crop || i.seed != args.common.seed || i.augment != args.augment || i.augment_variants as u64 != args.augment_variants {
+            say("note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been".into());
         }
         (loaded.varmap, loaded.model, opt, loaded.info)
     } else {
@@ -145,10 +244,40 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             batch: args.batch as usize,
             crop: args.crop as usize,
             dmax,
+            augment: 0.0,
+            augment_variants: 0,
             skeletons: Vec::new(),
         };
         (varmap, model, AdamW::new(args.lr), info)
     };
+    info.augment = args.augment;
+    info.augment_variants = args.augment_variants as usize;
+
+    let files = expand_inputs(&args.data)?;
+    let loaded = load_motions(&files, &LoadOptions::default())?;
+    let clips: Vec<RawClip> = loaded.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
+    let names = NameTable::builtin().context("the built-in joint-name table")?;
+    let augmentation = Augmentation { probability: args.augment, variants: args.augment_variants as usize, seed: info.seed };
+    let (set, dropped) = TrainSet::build(clips, names, info.dmax, &augmentation)?;
+    for d in &dropped {
+        say(format!("{d}: too short to crop, left out"));
+    }
+    say(format!(
+        "{} skeletons ({}), {} clips, {} feature frames; {} augmented variants",
+        set.skeletons.len(),
+        set.skeletons.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "),
+        set.skeletons.iter().map(|s| s.clips.len()).sum::<usize>(),
+        set.skeletons.iter().flat_map(|s| &s.clips).map(|c| c.frames).sum::<usize>(),
+        set.variant_count()
+    ));
+    for v in &set.skipped_variants {
+        say(format!("augmented variant left out: {v}"));
+    }
+    if args.common.verbose {
+        for v in set.augmented.iter().flatten() {
+            say(format!("variant {}: {} joints, {} clips", v.name, v.skeleton.len(), v.clips.len()));
+        }
+    }
     info.skeletons = set
         .skeletons
         .iter()
@@ -158,6 +287,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             parents: s.skeleton.parents(),
             stats: s.stats.clone(),
             clips: s.clips.len(),
+            offsets: s.skeleton.joints.iter().map(|j| j.offset.to_array()).collect(),
         })
         .collect();
     let vars = named_vars(&varmap);
@@ -166,12 +296,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let step_rng = |k: u64| SplitMix64::new(info.seed ^ k.wrapping_mul(0x9e37_79b9_7f4a_7c15));
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut log = std::fs::OpenOptions::new().create(true).append(true).open(args.out.join("log.jsonl")).context("cannot open the training log")?;
+    catch_interrupts()?;
     let started = Instant::now();
     let mut last_save = Instant::now();
+    let mut last_draw: Option<Instant> = None;
     let first = info.step;
     let every = Duration::from_secs_f64(args.checkpoint_minutes.max(0.0) * 60.0);
-    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr()) && !args.common.quiet;
     while info.step < args.steps {
+        if STOP.load(Ordering::SeqCst) {
+            if terminal {
+                eprintln!();
+            }
+            save(&args.out, &info, &varmap, &opt)?;
+            return Err(Interrupted { step: info.step }.into());
+        }
         let mut rng = step_rng(info.step);
         let stats = train_step(&model, &vars, &mut opt, &set, &schedule, &mut rng, args.batch as usize, args.crop as usize, args.lambda_geo, &device)?;
         info.step += 1;
@@ -180,19 +319,33 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let eta = (args.steps - info.step) as f64 / rate.max(1e-9);
         writeln!(log, "{{\"step\":{},\"loss\":{},\"steps_per_second\":{:.4},\"elapsed\":{:.2}}}", info.step, stats.loss, rate, started.elapsed().as_secs_f64())
             .context("cannot write the training log")?;
-        if !args.common.quiet && (terminal || info.step % 50 == 0 || info.step == args.steps) {
-            let line = format!("step {}/{}  loss {:.4}  {:.2} steps/s  ETA {:.0} s", info.step, args.steps, stats.loss, rate, eta);
-            if terminal { eprint!("\rmo-train: {line}   ") } else { eprintln!("mo-train: {line}") }
+        if terminal {
+            // Redraw at most ten times a second: fast tiny models would flood the terminal.
+            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || info.step == args.steps {
+                let width = args.steps.to_string().len();
+                eprint!(
+                    "\rmo-train: {} {:>width$}/{}  loss {:.4}  {:.2} steps/s  ETA {}   ",
+                    bar(info.step, args.steps, 30),
+                    info.step,
+                    args.steps,
+                    stats.loss,
+                    rate,
+                    duration(eta)
+                );
+                last_draw = Some(Instant::now());
+            }
+        } else if !args.common.quiet && (info.step % 50 == 0 || info.step == args.steps) {
+            eprintln!("mo-train: step {}/{}  loss {:.4}  {:.2} steps/s  ETA {}", info.step, args.steps, stats.loss, rate, duration(eta));
         }
         if last_save.elapsed() >= every {
-            checkpoint::save(&args.out, &info, &varmap, &opt)?;
+            save(&args.out, &info, &varmap, &opt)?;
             last_save = Instant::now();
         }
     }
-    if terminal && !args.common.quiet {
+    if terminal {
         eprintln!();
     }
-    checkpoint::save(&args.out, &info, &varmap, &opt)?;
+    save(&args.out, &info, &varmap, &opt)?;
     say(format!("saved step {} to {}", info.step, args.out.display()));
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! `optimizer.safetensors` (AdamW moments), and `checkpoint.json` (config, step, seed, the
 //! training settings, and per-skeleton normalisation statistics so that sampling a trained
 //! skeleton uses its own). Files are written beside their final names and renamed, so an
-//! interrupted save leaves the previous checkpoint whole.
+//! interrupted save never leaves a partial file.
 
 use super::train::AdamW;
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig};
@@ -25,12 +25,30 @@ pub struct TrainedSkeleton {
     pub parents: Vec<Option<usize>>,
     pub stats: AnyTopStats,
     pub clips: usize,
+    /// Rest offsets (BVH units), to tell proportion variants of one rig apart; empty in
+    /// checkpoints written before they were recorded.
+    #[serde(default)]
+    pub offsets: Vec<[f64; 3]>,
 }
 
 impl TrainedSkeleton {
+    /// Same joint names and parents (proportions aside).
     pub fn matches(&self, s: &Skeleton) -> bool {
         self.joints.len() == s.len() && s.joints.iter().zip(&self.joints).zip(&self.parents).all(|((j, n), p)| &j.name == n && &j.parent == p)
     }
+
+    /// The largest difference between a non-root rest offset of `s` and the recorded one
+    /// (0 when none are recorded); call only when `matches`.
+    fn offset_gap(&self, s: &Skeleton) -> f64 {
+        s.joints.iter().zip(&self.offsets).skip(1).map(|(j, o)| (j.offset - glam::DVec3::from_array(*o)).abs().max_element()).fold(0.0, f64::max)
+    }
+}
+
+/// The trained skeleton whose statistics suit `s`: among those with its joint names and
+/// parents, the one with the nearest rest offsets (proportion variants of one rig are trained
+/// as separate skeletons, `data::same_skeleton`).
+pub fn find_trained<'a>(trained: &'a [TrainedSkeleton], s: &Skeleton) -> Option<&'a TrainedSkeleton> {
+    trained.iter().filter(|t| t.matches(s)).min_by(|a, b| a.offset_gap(s).total_cmp(&b.offset_gap(s)))
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -45,24 +63,36 @@ pub struct CheckpointInfo {
     pub batch: usize,
     pub crop: usize,
     pub dmax: usize,
+    /// Skeletal augmentation: the chance a draw uses an augmented skeleton, and how many
+    /// variants each skeleton has (0 and 0 in checkpoints written before augmentation).
+    #[serde(default)]
+    pub augment: f64,
+    #[serde(default)]
+    pub augment_variants: usize,
     pub skeletons: Vec<TrainedSkeleton>,
 }
 
-fn write_then_rename(dir: &Path, name: &str, write: impl FnOnce(&Path) -> anyhow::Result<()>) -> anyhow::Result<()> {
-    let tmp = dir.join(format!(".{name}.tmp"));
-    write(&tmp)?;
-    std::fs::rename(&tmp, dir.join(name)).with_context(|| format!("cannot move {} into place", tmp.display()))
-}
-
-/// Save model, optimiser and info to `dir` (created if needed).
+/// Save model, optimiser and info to `dir` (created if needed). All three files are written
+/// under temporary names first and only then renamed into place, info last, so an
+/// interruption at any point leaves either the previous checkpoint's files or the new ones,
+/// never a partial file (the renames themselves are atomic).
 pub fn save(dir: &Path, info: &CheckpointInfo, varmap: &VarMap, opt: &AdamW) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    write_then_rename(dir, "model.safetensors", |p| varmap.save(p).with_context(|| format!("cannot write {}", p.display())))?;
+    let tmp = |name: &str| dir.join(format!(".{name}.tmp"));
+    let model = tmp("model.safetensors");
+    varmap.save(&model).with_context(|| format!("cannot write {}", model.display()))?;
     let state: std::collections::HashMap<String, candle_core::Tensor> = opt.state().into_iter().collect();
-    write_then_rename(dir, "optimizer.safetensors", |p| candle_core::safetensors::save(&state, p).with_context(|| format!("cannot write {}", p.display())))?;
-    // The info goes last: a checkpoint.json always describes complete tensor files.
+    let optimizer = tmp("optimizer.safetensors");
+    candle_core::safetensors::save(&state, &optimizer).with_context(|| format!("cannot write {}", optimizer.display()))?;
     let text = serde_json::to_string_pretty(info).context("serialising the checkpoint info")?;
-    write_then_rename(dir, "checkpoint.json", |p| std::fs::write(p, text + "\n").with_context(|| format!("cannot write {}", p.display())))
+    let json = tmp("checkpoint.json");
+    std::fs::write(&json, text + "\n").with_context(|| format!("cannot write {}", json.display()))?;
+    // The info goes last: a checkpoint.json always describes complete tensor files.
+    for name in ["model.safetensors", "optimizer.safetensors", "checkpoint.json"] {
+        let from = tmp(name);
+        std::fs::rename(&from, dir.join(name)).with_context(|| format!("cannot move {} into place", from.display()))?;
+    }
+    Ok(())
 }
 
 /// A loaded checkpoint.
@@ -96,4 +126,32 @@ pub fn load_optimizer(dir: &Path, info: &CheckpointInfo, device: &Device, lr: f6
     let mut opt = AdamW::new(lr);
     opt.load_state(&tensors, info.step);
     Ok(opt)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn find_trained_prefers_the_nearest_proportions() {
+        let (skeleton, _) = crate::synth::creature("quadruped", 0).unwrap();
+        let trained = |name: &str, scale: f64| TrainedSkeleton {
+            name: name.into(),
+            joints: skeleton.joints.iter().map(|j| j.name.clone()).collect(),
+            parents: skeleton.parents(),
+            stats: AnyTopStats { mean: vec![0.0; skeleton.len() * 13], std: vec![1.0; skeleton.len() * 13] },
+            clips: 1,
+            offsets: skeleton.joints.iter().map(|j| (j.offset * scale).to_array()).collect(),
+        };
+        let list = [trained("long", 1.3), trained("plain", 1.0), trained("short", 0.8)];
+        assert_eq!(find_trained(&list, &skeleton).map(|t| t.name.as_str()), Some("plain"));
+        let mut longer = skeleton.clone();
+        longer.joints.iter_mut().for_each(|j| j.offset *= 1.25);
+        assert_eq!(find_trained(&list, &longer).map(|t| t.name.as_str()), Some("long"));
+        // Older checkpoints record no offsets: names and parents decide.
+        let old = [TrainedSkeleton { offsets: Vec::new(), ..trained("old", 1.0) }];
+        assert_eq!(find_trained(&old, &longer).map(|t| t.name.as_str()), Some("old"));
+        let (crab, _) = crate::synth::creature("crab", 0).unwrap();
+        assert!(find_trained(&list, &crab).is_none());
+    }
 }

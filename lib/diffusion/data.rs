@@ -3,11 +3,26 @@
 //! name embeddings; clips encoded and normalised once; batches of random 40-frame crops drawn
 //! by the balancing sampler (every skeleton equally likely, then a clip of it uniformly).
 //!
-//! Grouping: clips whose joint names and parents are identical share a skeleton (one folder
-//! per creature in the corpus, but a folder is not required). The rest pose of a skeleton is
-//! the first two frames of a clip whose file name says T-pose, else of its first clip
-//! (AnyTop's rule, `anytop::names_tpose`).
+//! Grouping: clips whose joint names and parents are identical and whose rest offsets agree
+//! within `OFFSET_TOLERANCE` (relative to the skeleton's size) share a skeleton. Proportions
+//! matter: a long-legged variant of a creature has its own rest pose and statistics, as two
+//! performers of the same rig do in motion-capture sets. A folder is not required, but a
+//! group that is the only skeleton of its folder is named after the folder. The rest pose of
+//! a skeleton is the first two frames of a clip whose file name says T-pose, else of its first
+//! clip (AnyTop's rule, `anytop::names_tpose`).
+//!
+//! Skeletal augmentation (AnyTop §3.3, appendix C; reference/anytop.md §4): upstream edits
+//! every drawn sample on the fly, choosing uniformly among {none, remove joints, add a joint}.
+//! Re-encoding clips on every draw would cost more than the training step, so we precompute
+//! `Augmentation::variants` edited skeletons per skeleton at build time through `crate::augment`
+//! (even variants remove 10–30 % of the joints, odd ones subdivide one bone, as upstream's two
+//! edits), each prepared exactly like a real skeleton (own rig, P_S, statistics, R, D, names),
+//! and the sampler draws one with probability `Augmentation::probability` (default 2/3, the
+//! upstream odds). To bound memory, the clips of a skeleton are dealt round-robin over its
+//! variants (each clip is re-encoded for one variant only), so augmentation at most about
+//! doubles the feature memory.
 
+use crate::augment::{self, RemoveAmount};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::motion::Motion;
@@ -15,9 +30,16 @@ use crate::repr::anytop::{self, AnyTopOptions, AnyTopStats, RestSource};
 use crate::repr::Features;
 use crate::skeleton::{topology, Skeleton};
 use crate::synth::SplitMix64;
+use std::borrow::Cow;
+use std::path::Path;
 
 /// Clips shorter than this (in feature frames) are left out, as the reference does.
 pub const MIN_FRAMES: usize = 20;
+
+/// Two clips have the same proportions when every non-root rest offset differs by at most this
+/// fraction of the skeleton's rest extent. Re-exported rigs of one creature differ by ~1e-4
+/// (float printing); different performers or proportion variants by 1e-2 and more.
+pub const OFFSET_TOLERANCE: f64 = 1e-3;
 
 /// One clip as read from a file.
 pub struct RawClip {
@@ -43,9 +65,42 @@ pub struct SkeletonData {
     pub clip_names: Vec<String>,
 }
 
+/// Skeletal augmentation settings (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Augmentation {
+    /// Chance that a draw uses an augmented variant of the drawn skeleton, in [0, 1].
+    pub probability: f64,
+    /// Augmented variants prepared per skeleton (0: none).
+    pub variants: usize,
+    /// Seeds the choice of edits, so the same seed gives the same variants.
+    pub seed: u64,
+}
+
+impl Augmentation {
+    /// Upstream's odds: two of {none, remove, add} are augmentations.
+    pub const DEFAULT_PROBABILITY: f64 = 2.0 / 3.0;
+    pub const DEFAULT_VARIANTS: usize = 4;
+
+    /// No augmentation.
+    pub fn none() -> Augmentation {
+        Augmentation { probability: 0.0, variants: 0, seed: 0 }
+    }
+
+    /// The defaults with `seed`.
+    pub fn with_seed(seed: u64) -> Augmentation {
+        Augmentation { probability: Self::DEFAULT_PROBABILITY, variants: Self::DEFAULT_VARIANTS, seed }
+    }
+}
+
 /// A training set: skeletons with their clips.
 pub struct TrainSet {
     pub skeletons: Vec<SkeletonData>,
+    /// Augmented variants of `skeletons[i]` at `augmented[i]` (empty when there are none).
+    pub augmented: Vec<Vec<SkeletonData>>,
+    /// Chance that a draw uses an augmented variant (when its skeleton has any).
+    pub augment_probability: f64,
+    /// Augmented variants that could not be prepared, with the reason.
+    pub skipped_variants: Vec<String>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -56,91 +111,271 @@ pub enum DataError {
     Clip { clip: String, why: String },
     #[error("skeleton of {clip}: no clip has {min} or more frames", min = MIN_FRAMES + 1)]
     TooShort { clip: String },
+    #[error("augmentation probability must be in [0, 1], found {0}")]
+    Probability(f64),
 }
 
+/// True when `a` and `b` are the same skeleton: same joint names and parents, and rest offsets
+/// (root excluded: it places the body, it is not a proportion) within `OFFSET_TOLERANCE`.
+pub fn same_skeleton(a: &Skeleton, b: &Skeleton) -> bool {
+    if a.first_difference(b).is_some() {
+        return false;
+    }
+    let size = a.rest_extent().max(b.rest_extent());
+    let tolerance = if size.is_finite() && size > 0.0 { OFFSET_TOLERANCE * size } else { 0.0 };
+    a.joints.iter().zip(&b.joints).skip(1).all(|(x, y)| (x.offset - y.offset).abs().max_element() <= tolerance)
+}
+
+/// The folder part of a clip name ("" when none).
+fn folder_of(name: &str) -> String {
+    Path::new(name).parent().map(|p| p.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
+/// The file stem of a clip name.
+fn stem_of(name: &str) -> String {
+    Path::new(name).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| name.to_string())
+}
+
+/// A readable name per group: the folder's name when the group is the only skeleton of its
+/// folder, else the stem its clips' file names share (`biped_long_walk`, `biped_long_run` ->
+/// `biped_long`) when no other group's files share it, else its first clip's stem; made
+/// unique with `_2`, `_3`, ...
+fn group_names(groups: &[Vec<RawClip>]) -> Vec<String> {
+    let folders: Vec<Vec<String>> = groups.iter().map(|g| g.iter().map(|c| folder_of(&c.name)).collect()).collect();
+    let mut names = Vec::with_capacity(groups.len());
+    for (i, group) in groups.iter().enumerate() {
+        let folder = &folders[i][0];
+        let only_here = folders[i].iter().all(|f| f == folder) && folders.iter().enumerate().all(|(k, fs)| k == i || !fs.contains(folder));
+        let folder_name = Path::new(folder).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = if only_here && !folder_name.is_empty() && folder_name != "." && folder_name != ".." {
+            folder_name
+        } else {
+            let stems: Vec<String> = group.iter().map(|c| stem_of(&c.name)).collect();
+            let mut prefix = stems[0].clone();
+            for s in &stems[1..] {
+                let common = prefix.chars().zip(s.chars()).take_while(|(a, b)| a == b).count();
+                prefix = prefix.chars().take(common).collect();
+            }
+            let prefix = prefix.trim_end_matches(['_', '-', '.', ' ']).to_string();
+            // A prefix that other groups' files share too (`dataset-1_...`) says nothing.
+            let distinctive = prefix.chars().count() >= 2 && groups.iter().enumerate().all(|(k, g)| k == i || g.iter().all(|c| !stem_of(&c.name).starts_with(&prefix)));
+            if distinctive { prefix } else { stems[0].clone() }
+        };
+        let mut unique = name.clone();
+        let mut k = 2;
+        while names.contains(&unique) {
+            unique = format!("{name}_{k}");
+            k += 1;
+        }
+        names.push(unique);
+    }
+    names
+}
+
+/// Prepare one skeleton from its clips: rig and P_S from `rest` (file name, motion), features
+/// of every clip long enough (the others go to `dropped`), statistics, topology and names.
+/// `None` when no clip is long enough.
+fn prepare<'a>(
+    name: String,
+    skeleton: Skeleton,
+    rest: (&str, &Motion),
+    clips: impl Iterator<Item = (String, Cow<'a, Motion>)>,
+    names: &NameTable,
+    dmax: usize,
+    dropped: &mut Vec<String>,
+) -> Result<Option<SkeletonData>, DataError> {
+    let (rest_name, rest_motion) = rest;
+    let source = if anytop::names_tpose(rest_name) { RestSource::TPose { file: rest_name.to_string() } } else { RestSource::FirstClip { file: rest_name.to_string() } };
+    let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
+    let section = AnyTopSection::new(&skeleton, &rest_motion.first_frames(2), &options).map_err(|e| DataError::Clip { clip: rest_name.to_string(), why: e.to_string() })?;
+    let mut features = Vec::new();
+    let mut clip_names = Vec::new();
+    for (clip, motion) in clips {
+        if motion.frames < MIN_FRAMES + 1 {
+            dropped.push(clip);
+            continue;
+        }
+        let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| DataError::Clip { clip: clip.clone(), why: e.to_string() })?;
+        features.push(encoded.features);
+        clip_names.push(clip);
+    }
+    if features.is_empty() {
+        return Ok(None);
+    }
+    let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: name.clone(), why: e.to_string() };
+    let stats = AnyTopStats::compute(features.iter()).map_err(|e| fail(&e))?;
+    for f in &mut features {
+        stats.normalise(f).map_err(|e| fail(&e))?;
+    }
+    let mut rest = Features { frames: 1, joints: skeleton.len(), dims: anytop::FEATURE_DIMS, data: section.rest_row.concat() };
+    stats.normalise(&mut rest).map_err(|e| fail(&e))?;
+    Ok(Some(SkeletonData {
+        relations: topology::relations(&skeleton),
+        distances: topology::distances(&skeleton, dmax),
+        names: names.embed_skeleton(&skeleton),
+        rest_row: rest.data,
+        name,
+        skeleton,
+        section,
+        stats,
+        clips: features,
+        clip_names,
+    }))
+}
+
+/// Which frames of a skeleton's clips (lengths `frames`) variant `v` of `variants` carries,
+/// as (clip, frame range): clips `v`, `v + variants`, ... whole when there are at least as
+/// many clips as variants; otherwise one contiguous piece of clip `v mod n`, cut into as many
+/// pieces as variants share it (but never shorter than a croppable clip). Either way each
+/// frame goes to about one variant, so augmentation at most about doubles the memory.
+fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Range<usize>)> {
+    let n = frames.len();
+    if n >= variants {
+        return (v..n).step_by(variants).map(|c| (c, 0..frames[c])).collect();
+    }
+    let clip = v % n;
+    let sharing = (clip..variants).step_by(n).count().max(1);
+    let piece = v / n;
+    let len = frames[clip];
+    // +1: motion frames, one more than feature frames.
+    let size = len.div_ceil(sharing).max(MIN_FRAMES + 2).min(len);
+    let start = (piece * len / sharing).min(len - size);
+    vec![(clip, start..start + size)]
+}
+
+/// The augmented variants of one skeleton (group `index` of the set): variant `v` removes
+/// joints (`v` even) or subdivides one bone (`v` odd) and carries the frames `deal` gives it.
+/// Variants whose edit changes nothing, or whose clips are all too short, are left out; so are
+/// variants that cannot be prepared (returned with the reason): an augmentation is never
+/// worth failing a training run for.
+fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawClip, aug: &Augmentation, names: &NameTable, dmax: usize) -> (Vec<SkeletonData>, Vec<String>) {
+    let (mut out, mut skipped) = (Vec::new(), Vec::new());
+    for v in 0..aug.variants {
+        // One stream per (seed, skeleton, variant): adding a skeleton or a variant leaves the
+        // others' edits as they were.
+        let mut rng = SplitMix64::new(aug.seed ^ 0xa076_1d64_78bd_642f ^ ((index as u64) << 20 | v as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let options = if v % 2 == 0 {
+            augment::Options { remove: Some(RemoveAmount::Random), add: 0, keep_feet: true }
+        } else {
+            augment::Options { remove: None, add: 1, keep_feet: true }
+        };
+        let plan = augment::plan(&base.skeleton, &options, &mut rng);
+        if plan.is_empty() {
+            continue;
+        }
+        // Only croppable clips are dealt (a T-pose file would leave its variant without any).
+        let usable: Vec<&RawClip> = group.iter().filter(|c| c.motion.frames > MIN_FRAMES + 1).collect();
+        if usable.is_empty() {
+            continue;
+        }
+        let pieces = deal(&usable.iter().map(|c| c.motion.frames).collect::<Vec<_>>(), v, aug.variants);
+        let tag = if v % 2 == 0 { format!("remove{}", plan.joints_before - plan.skeleton.len()) } else { "add1".to_string() };
+        let rest_motion = plan.apply_motion(&base.skeleton, &rest.motion.first_frames(2));
+        let clips = pieces.into_iter().map(|(c, range)| {
+            let clip = usable[c];
+            let motion = if range == (0..clip.motion.frames) { plan.apply_motion(&base.skeleton, &clip.motion) } else { plan.apply_motion(&base.skeleton, &clip.motion.frame_range(range.start, range.end)) };
+            (clip.name.clone(), Cow::Owned(motion))
+        });
+        let mut ignored = Vec::new();
+        let name = format!("{}__{tag}_v{v}", base.name);
+        match prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, names, dmax, &mut ignored) {
+            Ok(Some(data)) => out.push(data),
+            Ok(None) => {}
+            Err(e) => skipped.push(format!("{name}: {e}")),
+        }
+    }
+    (out, skipped)
+}
 
 impl TrainSet {
-    /// Group `clips` by skeleton and prepare them. Clips too short to crop are dropped
-    /// (returned by name, so the caller can say so).
-    pub fn build(clips: Vec<RawClip>, names: &NameTable, dmax: usize) -> Result<(TrainSet, Vec<String>), DataError> {
+    /// Group `clips` by skeleton and prepare them, with augmented variants as `aug` says.
+    /// Clips too short to crop are dropped (returned by name, so the caller can say so).
+    pub fn build(clips: Vec<RawClip>, names: &NameTable, dmax: usize, aug: &Augmentation) -> Result<(TrainSet, Vec<String>), DataError> {
         if clips.is_empty() {
             return Err(DataError::Empty);
         }
+        if !(0.0..=1.0).contains(&aug.probability) {
+            return Err(DataError::Probability(aug.probability));
+        }
         let mut groups: Vec<Vec<RawClip>> = Vec::new();
         for c in clips {
-            match groups.iter_mut().find(|g| g[0].skeleton.first_difference(&c.skeleton).is_none()) {
+            match groups.iter_mut().find(|g| same_skeleton(&g[0].skeleton, &c.skeleton)) {
                 Some(g) => g.push(c),
                 None => groups.push(vec![c]),
             }
         }
+        let group_names = group_names(&groups);
         let mut skeletons = Vec::with_capacity(groups.len());
+        let mut augmented = Vec::with_capacity(groups.len());
         let mut dropped = Vec::new();
-        for group in groups {
-            let rest_clip = group.iter().find(|c| anytop::names_tpose(&c.name)).unwrap_or(&group[0]);
-            let source = if anytop::names_tpose(&rest_clip.name) {
-                RestSource::TPose { file: rest_clip.name.clone() }
-            } else {
-                RestSource::FirstClip { file: rest_clip.name.clone() }
-            };
+        let mut skipped_variants = Vec::new();
+        let mut first_short = None;
+        for (index, (group, name)) in groups.into_iter().zip(group_names).enumerate() {
+            let rest = group.iter().find(|c| anytop::names_tpose(&c.name)).unwrap_or(&group[0]);
             let skeleton = group[0].skeleton.clone();
-            let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
-            let section = AnyTopSection::new(&skeleton, &rest_clip.motion.first_frames(2), &options)
-                .map_err(|e| DataError::Clip { clip: rest_clip.name.clone(), why: e.to_string() })?;
-            let mut features = Vec::new();
-            let mut clip_names = Vec::new();
-            for c in &group {
-                if c.motion.frames < MIN_FRAMES + 1 {
-                    dropped.push(c.name.clone());
-                    continue;
-                }
-                let encoded = section.rig.encode(&skeleton, &c.motion).map_err(|e| DataError::Clip { clip: c.name.clone(), why: e.to_string() })?;
-                features.push(encoded.features);
-                clip_names.push(c.name.clone());
-            }
-            if features.is_empty() {
-                return Err(DataError::TooShort { clip: group[0].name.clone() });
-            }
-            let stats = AnyTopStats::compute(features.iter()).map_err(|e| DataError::Clip { clip: group[0].name.clone(), why: e.to_string() })?;
-            for f in &mut features {
-                stats.normalise(f).map_err(|e| DataError::Clip { clip: group[0].name.clone(), why: e.to_string() })?;
-            }
-            let mut rest = Features { frames: 1, joints: skeleton.len(), dims: anytop::FEATURE_DIMS, data: section.rest_row.concat() };
-            stats.normalise(&mut rest).map_err(|e| DataError::Clip { clip: group[0].name.clone(), why: e.to_string() })?;
-            skeletons.push(SkeletonData {
-                name: group[0].name.clone(),
-                relations: topology::relations(&skeleton),
-                distances: topology::distances(&skeleton, dmax),
-                names: names.embed_skeleton(&skeleton),
-                rest_row: rest.data,
-                skeleton,
-                section,
-                stats,
-                clips: features,
-                clip_names,
-            });
+            let clips = group.iter().map(|c| (c.name.clone(), Cow::Borrowed(&c.motion)));
+            // A skeleton with no croppable clip (a lone bind-pose file) is left out, its clips
+            // reported as dropped; only a set with nothing left is an error.
+            let Some(data) = prepare(name, skeleton, (&rest.name, &rest.motion), clips, names, dmax, &mut dropped)? else {
+                first_short.get_or_insert_with(|| group[0].name.clone());
+                continue;
+            };
+            // Variants nobody will draw are not worth their memory.
+            let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
+            let (variants, skipped) = variants_of(index, &data, &group, rest, &wanted, names, dmax);
+            augmented.push(variants);
+            skipped_variants.extend(skipped);
+            skeletons.push(data);
         }
-        Ok((TrainSet { skeletons }, dropped))
+        if skeletons.is_empty() {
+            return Err(DataError::TooShort { clip: first_short.unwrap_or_default() });
+        }
+        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants }, dropped))
+    }
+
+    /// The skeleton (original or augmented variant) a crop comes from.
+    pub fn data(&self, crop: &Crop) -> &SkeletonData {
+        match crop.variant {
+            Some(v) => &self.augmented[crop.skeleton][v],
+            None => &self.skeletons[crop.skeleton],
+        }
+    }
+
+    /// Augmented variants in all.
+    pub fn variant_count(&self) -> usize {
+        self.augmented.iter().map(Vec::len).sum()
     }
 
     /// Draw `batch` crops of at most `frames` feature frames: a skeleton uniformly (each gets
-    /// 1/#skeletons, AnyTop's balancing sampler), a clip of it uniformly, a crop start uniformly.
+    /// 1/#skeletons, AnyTop's balancing sampler), with `augment_probability` one of its
+    /// augmented variants (uniformly) instead, a clip of it uniformly, a crop start uniformly.
     pub fn sample(&self, rng: &mut SplitMix64, batch: usize, frames: usize) -> Vec<Crop> {
         (0..batch)
             .map(|_| {
                 let s = rng.below(self.skeletons.len());
-                let sk = &self.skeletons[s];
+                let variants = &self.augmented[s];
+                // No draw at all when augmentation is off, so such runs keep their old stream.
+                let variant = if !variants.is_empty() && self.augment_probability > 0.0 && rng.unit() < self.augment_probability {
+                    Some(rng.below(variants.len()))
+                } else {
+                    None
+                };
+                let sk = match variant {
+                    Some(v) => &variants[v],
+                    None => &self.skeletons[s],
+                };
                 let c = rng.below(sk.clips.len());
                 let clip = &sk.clips[c];
                 let len = clip.frames.min(frames);
                 let start = rng.below(clip.frames - len + 1);
-                Crop { skeleton: s, clip: c, start, frames: len }
+                Crop { skeleton: s, variant, clip: c, start, frames: len }
             })
             .collect()
     }
 
     /// The features of a crop, `[frames, joints, 13]` (normalised).
     pub fn crop(&self, crop: &Crop) -> Features {
-        let clip = &self.skeletons[crop.skeleton].clips[crop.clip];
+        let clip = &self.data(crop).clips[crop.clip];
         let width = clip.joints * clip.dims;
         Features { frames: crop.frames, joints: clip.joints, dims: clip.dims, data: clip.data[crop.start * width..(crop.start + crop.frames) * width].to_vec() }
     }
@@ -150,11 +385,12 @@ impl TrainSet {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Crop {
     pub skeleton: usize,
+    /// `Some(v)`: augmented variant `v` of the skeleton.
+    pub variant: Option<usize>,
     pub clip: usize,
     pub start: usize,
     pub frames: usize,
 }
-
 
 #[cfg(test)]
 mod tests {
@@ -167,21 +403,45 @@ mod tests {
             .flat_map(|n| {
                 (0..2).map(move |seed| {
                     let (skeleton, motion) = synth::creature(n, seed).unwrap();
-                    RawClip { name: format!("{n}_{seed}.bvh"), skeleton, motion }
+                    RawClip { name: format!("{n}/{n}_{seed}.bvh"), skeleton, motion }
                 })
             })
             .collect()
     }
 
+    /// The same clip twice more: once with offsets nudged far below the tolerance, once with
+    /// longer legs (every offset below the root x1.2).
+    fn proportions() -> Vec<RawClip> {
+        let (skeleton, motion) = synth::creature("quadruped", 0).unwrap();
+        let mut nudged = skeleton.clone();
+        nudged.joints.iter_mut().skip(1).for_each(|j| j.offset *= 1.0 + 1e-6);
+        let mut long = skeleton.clone();
+        long.joints.iter_mut().skip(1).for_each(|j| j.offset *= 1.2);
+        // Translations replace OFFSETs in a motion (`Motion` doc): scale them too.
+        let mut long_motion = motion.clone();
+        long_motion.translations.iter_mut().enumerate().filter(|(i, _)| i % long.len() != 0).for_each(|(_, t)| *t *= 1.2);
+        vec![
+            RawClip { name: "zoo/quad_walk.bvh".into(), skeleton, motion: motion.clone() },
+            RawClip { name: "zoo/quad_run.bvh".into(), skeleton: nudged, motion: motion.clone() },
+            RawClip { name: "zoo/long_quad_walk.bvh".into(), skeleton: long, motion: long_motion },
+        ]
+    }
+
     #[test]
     fn clips_group_by_skeleton_and_normalise() {
         let names = NameTable::builtin().unwrap();
-        let clips = zoo();
-        let (set, dropped) = TrainSet::build(clips, names, topology::DEFAULT_DMAX).unwrap();
-        assert!(dropped.is_empty());
-        // Seeds may change a creature's proportions but not its joints: two clips per skeleton.
-        let per: Vec<usize> = set.skeletons.iter().map(|s| s.clips.len()).collect();
-        assert_eq!(per.iter().sum::<usize>(), 6);
+        // A skeleton whose only clip is too short is left out, not an error.
+        let mut clips = zoo();
+        let (skeleton, motion) = synth::creature("crab", 0).unwrap();
+        clips.push(RawClip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) });
+        let (set, dropped) = TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        assert_eq!(dropped, ["crab/bind.bvh"]);
+        assert!(set.skeletons.iter().all(|s| s.name != "crab"));
+        let (skeleton, motion) = synth::creature("crab", 0).unwrap();
+        let short = vec![RawClip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) }];
+        assert!(matches!(TrainSet::build(short, names, topology::DEFAULT_DMAX, &Augmentation::none()), Err(DataError::TooShort { .. })));
+        assert_eq!(set.skeletons.iter().map(|s| s.clips.len()).sum::<usize>(), 6);
+        assert_eq!(set.variant_count(), 0);
         for s in &set.skeletons {
             let j = s.skeleton.len();
             assert_eq!(s.rest_row.len(), j * 13);
@@ -199,9 +459,105 @@ mod tests {
     }
 
     #[test]
+    fn proportions_split_skeletons_and_groups_get_readable_names() {
+        let names = NameTable::builtin().unwrap();
+        let (set, _) = TrainSet::build(proportions(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        let got: Vec<(&str, usize)> = set.skeletons.iter().map(|s| (s.name.as_str(), s.clips.len())).collect();
+        // Two skeletons share the folder, so they are named by what their file names share.
+        assert_eq!(got, vec![("quad", 2), ("long_quad_walk", 1)]);
+        assert_ne!(set.skeletons[0].rest_row, set.skeletons[1].rest_row, "each proportion has its own rest pose");
+        // A prefix other groups' files share is no name: the first clip's stem instead.
+        let mut clips = proportions();
+        clips[2].name = "zoo/quad_long_walk.bvh".into();
+        let (set, _) = TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        assert_eq!(set.skeletons.iter().map(|s| s.name.as_str()).collect::<Vec<_>>(), ["quad_walk", "quad_long_walk"]);
+        // One skeleton per folder: the folder names it.
+        let (set, _) = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        let folders: Vec<&str> = set.skeletons.iter().map(|s| s.name.as_str()).collect();
+        if set.skeletons.len() == 3 {
+            assert_eq!(folders, ["biped", "quadruped", "spider"]);
+        } else {
+            // Seeds vary proportions: several skeletons per folder, all names distinct.
+            let mut unique = folders.clone();
+            unique.sort();
+            unique.dedup();
+            assert_eq!(unique.len(), folders.len(), "{folders:?}");
+        }
+    }
+
+    #[test]
+    fn frames_are_dealt_over_variants_once() {
+        // Enough clips: whole clips, round-robin.
+        assert_eq!(deal(&[30, 40, 50, 60, 70], 1, 4), vec![(1, 0..40)]);
+        assert_eq!(deal(&[30, 40, 50, 60, 70], 0, 4), vec![(0, 0..30), (4, 0..70)]);
+        // Two clips, four variants: each clip in two halves.
+        let pieces: Vec<_> = (0..4).map(|v| deal(&[100, 60], v, 4)).collect();
+        assert_eq!(pieces, vec![vec![(0, 0..50)], vec![(1, 0..30)], vec![(0, 50..100)], vec![(1, 30..60)]]);
+        // A short clip: pieces overlap rather than get too short to crop.
+        for v in 0..4 {
+            let p = deal(&[30], v, 4);
+            assert_eq!(p.len(), 1);
+            assert!(p[0].1.len() == MIN_FRAMES + 2 && p[0].1.end <= 30, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn augmented_variants_are_whole_skeletons_and_deterministic() {
+        let names = NameTable::builtin().unwrap();
+        let aug = Augmentation::with_seed(7);
+        let build = || TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug).unwrap().0;
+        let set = build();
+        assert!(set.variant_count() >= set.skeletons.len(), "every zoo creature can lose and gain joints");
+        let original_frames: usize = set.skeletons.iter().flat_map(|s| &s.clips).map(|c| c.frames * c.joints).sum();
+        let variant_frames: usize = set.augmented.iter().flatten().flat_map(|s| &s.clips).map(|c| c.frames * c.joints).sum();
+        assert!(variant_frames <= original_frames * 5 / 4, "clips are dealt over variants: {variant_frames} vs {original_frames}");
+        for (base, variants) in set.skeletons.iter().zip(&set.augmented) {
+            for v in variants {
+                let j = v.skeleton.len();
+                assert_ne!(j, base.skeleton.len(), "{}", v.name);
+                assert!(v.name.starts_with(&base.name) && v.name.contains("__"), "{}", v.name);
+                assert_eq!(v.rest_row.len(), j * 13);
+                assert_eq!((v.relations.len(), v.distances.len(), v.names.len(), v.stats.mean.len()), (j, j, j, j * 13));
+                assert!(v.clips.iter().all(|c| c.joints == j && c.data.iter().all(|x| x.is_finite())));
+            }
+        }
+        let again = build();
+        let shape = |s: &TrainSet| s.augmented.iter().flatten().map(|v| (v.name.clone(), v.skeleton.len(), v.clips[0].data.clone())).collect::<Vec<_>>();
+        assert_eq!(shape(&set), shape(&again), "same seed, same variants");
+        let other = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::with_seed(8)).unwrap().0;
+        assert_ne!(shape(&set), shape(&other), "the seed chooses the edits");
+    }
+
+    #[test]
+    fn the_sampler_draws_variants_with_the_asked_probability() {
+        let names = NameTable::builtin().unwrap();
+        let mut aug = Augmentation::with_seed(1);
+        let (mut set, _) = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug).unwrap();
+        let share = |set: &TrainSet| {
+            let crops = set.sample(&mut SplitMix64::new(4), 600, 40);
+            for c in &crops {
+                let clip = &set.data(c).clips[c.clip];
+                assert!(c.frames <= 40 && c.start + c.frames <= clip.frames);
+                assert_eq!(set.crop(c).joints, set.data(c).skeleton.len());
+            }
+            crops.iter().filter(|c| c.variant.is_some()).count() as f64 / crops.len() as f64
+        };
+        let p = share(&set);
+        assert!((p - 2.0 / 3.0).abs() < 0.08, "{p}");
+        set.augment_probability = 0.0;
+        assert_eq!(share(&set), 0.0);
+        let off = Augmentation { probability: 0.0, ..aug };
+        assert_eq!(TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &off).unwrap().0.variant_count(), 0, "probability 0: no variants built");
+        set.augment_probability = 1.0;
+        assert_eq!(share(&set), 1.0);
+        aug.probability = 1.5;
+        assert!(matches!(TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug), Err(DataError::Probability(_))));
+    }
+
+    #[test]
     fn sampling_is_balanced_deterministic_and_in_range() {
         let names = NameTable::builtin().unwrap();
-        let (set, _) = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX).unwrap();
+        let (set, _) = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
         let a = set.sample(&mut SplitMix64::new(3), 300, 40);
         let b = set.sample(&mut SplitMix64::new(3), 300, 40);
         assert_eq!(a, b);

@@ -1,5 +1,5 @@
 //! Training the denoiser (AnyTop §3.3–3.4): x0 prediction, loss = masked MSE in normalised
-//! space over real joints and frames, AdamW (lr 1e-4, no weight decay, as the reference), and
+//! space over real joints and frames plus λ_geo × the geodesic rotation angle, AdamW (lr 1e-4, no weight decay, as the reference), and
 //! checkpoints that can resume exactly.
 //!
 //! The optimiser is ours rather than candle-nn's `AdamW` because a checkpoint must carry the
@@ -11,7 +11,8 @@ use super::data::{Crop, TrainSet};
 use super::schedule::Schedule;
 use crate::nn::{batch_from, BatchItem, Denoiser};
 use crate::synth::SplitMix64;
-use candle_core::{DType, Device, Tensor, Var};
+use candle_core::cpu_backend::unary_map;
+use candle_core::{CpuStorage, CustomOp1, DType, Device, Layout, Shape, Tensor, Var};
 use candle_nn::VarMap;
 use std::collections::BTreeMap;
 
@@ -111,19 +112,18 @@ pub struct StepStats {
     pub loss: f64,
 }
 
-/// One training step: draw a batch of crops and timesteps, noise the motion (never the rest
-/// token), predict x0; loss = masked MSE (normalised space) + `lambda_geo` × the rotation
-/// distance of the 6D rotations (physical space), both over real joints and frames, as the
-/// reference (§3.3, λ_geo = 1 in its training commands); backward, AdamW.
+/// The training loss of one batch: draw `batch` crops and timesteps, noise the motion (never
+/// the rest token), predict x0; loss = masked MSE (normalised space) + `lambda_geo` × the
+/// geodesic rotation distance of the 6D rotations (physical space), both over real joints and
+/// frames, as the reference (§3.3, λ_geo = 1 in its training commands).
 ///
-/// The crops of each skeleton go through the model as their own sub-batch: padding every crop
-/// to the batch's largest skeleton (88 joints for the centipede next to 14 for the fish) would
-/// spend most of the attention work on padding. The model gives a clip the same output alone
-/// or padded (nn tests), so this changes the cost, not the loss.
-pub fn train_step(
+/// The crops of each skeleton (or augmented variant) go through the model as their own
+/// sub-batch: padding every crop to the batch's largest skeleton (88 joints for the centipede
+/// next to 14 for the fish) would spend most of the attention work on padding. The model gives
+/// a clip the same output alone or padded (nn tests), so this changes the cost, not the loss.
+#[allow(clippy::too_many_arguments)]
+pub fn training_loss(
     model: &Denoiser,
-    vars: &BTreeMap<String, Var>,
-    opt: &mut AdamW,
     set: &TrainSet,
     schedule: &Schedule,
     rng: &mut SplitMix64,
@@ -131,51 +131,59 @@ pub fn train_step(
     crop: usize,
     lambda_geo: f64,
     device: &Device,
-) -> anyhow::Result<StepStats> {
+) -> anyhow::Result<Tensor> {
     let crops = set.sample(rng, batch, crop);
     let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
-    let mut order: Vec<usize> = Vec::new();
+    let mut order: Vec<(usize, Option<usize>)> = Vec::new();
     for c in &crops {
-        if !order.contains(&c.skeleton) {
-            order.push(c.skeleton);
+        if !order.contains(&(c.skeleton, c.variant)) {
+            order.push((c.skeleton, c.variant));
         }
     }
     let mut total: Option<LossSums> = None;
-    for skeleton in order {
-        let chosen: Vec<usize> = (0..crops.len()).filter(|&i| crops[i].skeleton == skeleton).collect();
+    for key in order {
+        let chosen: Vec<usize> = (0..crops.len()).filter(|&i| (crops[i].skeleton, crops[i].variant) == key).collect();
         let part_crops: Vec<Crop> = chosen.iter().map(|&i| crops[i]).collect();
         let part_steps: Vec<u32> = chosen.iter().map(|&i| steps[i]).collect();
-        let part = loss_sums(model, set, schedule, &part_crops, &part_steps, rng, device)?;
+        let part = loss_sums(model, set, schedule, &part_crops, &part_steps, rng, lambda_geo != 0.0, device)?;
         total = Some(match total {
             None => part,
-            Some(t) => LossSums { squared: (t.squared + part.squared)?, values: t.values + part.values, rotation: (t.rotation + part.rotation)?, tokens: t.tokens + part.tokens },
+            Some(t) => LossSums {
+                squared: (t.squared + part.squared)?,
+                values: t.values + part.values,
+                rotation: match (t.rotation, part.rotation) {
+                    (Some(a), Some(b)) => Some((a + b)?),
+                    _ => None,
+                },
+                tokens: t.tokens + part.tokens,
+            },
         });
     }
     let Some(sums) = total else { anyhow::bail!("an empty training batch") };
     let mse = (sums.squared / sums.values.max(1.0))?;
-    let geo = (sums.rotation / sums.tokens.max(1.0))?;
-    let loss = (&mse + (geo * lambda_geo)?)?;
-    let grads = loss.backward()?;
-    opt.update(vars, &grads)?;
-    Ok(StepStats { loss: loss.to_scalar::<f32>()? as f64 })
+    match sums.rotation {
+        Some(rotation) if lambda_geo != 0.0 => Ok((&mse + ((rotation / sums.tokens.max(1.0))? * lambda_geo)?)?),
+        _ => Ok(mse),
+    }
 }
 
 /// Unnormalised loss terms of one sub-batch: summed squared error and the number of values it
-/// covers, summed rotation distance and the number of tokens.
+/// covers, summed rotation distance (when asked for) and the number of tokens.
 struct LossSums {
     squared: Tensor,
     values: f64,
-    rotation: Tensor,
+    rotation: Option<Tensor>,
     tokens: f64,
 }
 
-fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, device: &Device) -> anyhow::Result<LossSums> {
+#[allow(clippy::too_many_arguments)]
+fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, rotation: bool, device: &Device) -> anyhow::Result<LossSums> {
     let features: Vec<_> = crops.iter().map(|c| set.crop(c)).collect();
     let items: Vec<BatchItem> = crops
         .iter()
         .zip(&features)
         .map(|(c, f)| {
-            let s = &set.skeletons[c.skeleton];
+            let s = set.data(c);
             BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 }
         })
         .collect();
@@ -196,15 +204,19 @@ fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Cro
     let mask = clean.frame_mask.reshape((b, t, 1, 1))?.broadcast_mul(&clean.joint_mask.reshape((b, 1, j, 1))?)?.broadcast_mul(&motion_token)?;
     let squared = (&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask)?.sum_all()?;
     let tokens = mask.sum_all()?.to_scalar::<f32>()? as f64;
+    let values = tokens * d as f64;
+    if !rotation {
+        return Ok(LossSums { squared, values, rotation: None, tokens });
+    }
     // The rotation term needs the 6D values in physical units: undo each skeleton's
     // normalisation (padded joints get mean 0, std 1; they are masked anyway).
     let (mut mean, mut std) = (vec![0f32; b * j * 6], vec![1f32; b * j * 6]);
     for (i, c) in crops.iter().enumerate() {
-        let stats = &set.skeletons[c.skeleton].stats;
-        for jj in 0..set.skeletons[c.skeleton].skeleton.len() {
+        let sk = set.data(c);
+        for jj in 0..sk.skeleton.len() {
             for k in 0..6 {
-                mean[(i * j + jj) * 6 + k] = stats.mean[jj * d + 3 + k];
-                std[(i * j + jj) * 6 + k] = stats.std[jj * d + 3 + k] + crate::repr::anytop::STD_EPSILON;
+                mean[(i * j + jj) * 6 + k] = sk.stats.mean[jj * d + 3 + k];
+                std[(i * j + jj) * 6 + k] = sk.stats.std[jj * d + 3 + k] + crate::repr::anytop::STD_EPSILON;
             }
         }
     }
@@ -213,13 +225,98 @@ fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Cro
     let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(3, 3, 6)?.broadcast_mul(&std)?.broadcast_add(&mean) };
     let geo = rotation_distance(&physical(&predicted)?, &physical(&clean.x)?)?;
     let rotation = geo.unsqueeze(3)?.broadcast_mul(&mask)?.sum_all()?;
-    Ok(LossSums { squared, values: tokens * d as f64, rotation, tokens })
+    Ok(LossSums { squared, values, rotation: Some(rotation), tokens })
 }
 
-/// 1 − cos θ of the rotation between two 6D rotations (first two matrix columns, `[..., 6]`),
-/// per token: (3 − tr(R̂ᵀR)) / 2. The reference takes θ itself (arccos); candle has no arccos,
-/// and 1 − cos θ is a smooth, monotone function of θ (≈ θ²/2 for small angles) with the same
-/// minimiser, whose gradient does not blow up at θ = 0 as arccos's does.
+/// One training step: `training_loss`, backward, AdamW.
+#[allow(clippy::too_many_arguments)]
+pub fn train_step(
+    model: &Denoiser,
+    vars: &BTreeMap<String, Var>,
+    opt: &mut AdamW,
+    set: &TrainSet,
+    schedule: &Schedule,
+    rng: &mut SplitMix64,
+    batch: usize,
+    crop: usize,
+    lambda_geo: f64,
+    device: &Device,
+) -> anyhow::Result<StepStats> {
+    let loss = training_loss(model, set, schedule, rng, batch, crop, lambda_geo, device)?;
+    let grads = loss.backward()?;
+    opt.update(vars, &grads)?;
+    Ok(StepStats { loss: loss.to_scalar::<f32>()? as f64 })
+}
+
+/// The cosine argument is clamped to [−1 + ε, 1 − ε] before arccos, as the reference does, so
+/// the angle and its gradient stay finite at θ = 0 and θ = π.
+pub const ARCCOS_EPSILON: f64 = 1e-6;
+
+/// θ = arccos(clamp(x, −1 + ε, 1 − ε)) elementwise, with a backward: candle has no arccos.
+/// The derivative is −1/√(1 − x²) inside the clamp and 0 outside it (the clamp's derivative,
+/// as in the reference's PyTorch), at most ~707 in magnitude.
+struct ClampedArccos;
+
+/// The derivative of `ClampedArccos` at its input (a forward-only op: no second derivatives).
+struct ClampedArccosDerivative;
+
+fn clamped(x: f64) -> f64 {
+    x.clamp(-1.0 + ARCCOS_EPSILON, 1.0 - ARCCOS_EPSILON)
+}
+
+fn derivative(x: f64) -> f64 {
+    if x.abs() <= 1.0 - ARCCOS_EPSILON {
+        -1.0 / (1.0 - x * x).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// Apply `f` to every element of a float CPU tensor (f32 in f64 arithmetic, so the clamp
+/// bounds are exact).
+fn map_float(name: &'static str, storage: &CpuStorage, layout: &Layout, f: fn(f64) -> f64) -> candle_core::Result<(CpuStorage, Shape)> {
+    let out = match storage {
+        CpuStorage::F32(v) => CpuStorage::F32(unary_map(v, layout, |x| f(x as f64) as f32)),
+        CpuStorage::F64(v) => CpuStorage::F64(unary_map(v, layout, f)),
+        _ => candle_core::bail!("{name}: expected f32 or f64 values"),
+    };
+    Ok((out, layout.shape().clone()))
+}
+
+impl CustomOp1 for ClampedArccos {
+    fn name(&self) -> &'static str {
+        "clamped-arccos"
+    }
+
+    fn cpu_fwd(&self, storage: &CpuStorage, layout: &Layout) -> candle_core::Result<(CpuStorage, Shape)> {
+        map_float(self.name(), storage, layout, |x| clamped(x).acos())
+    }
+
+    fn bwd(&self, arg: &Tensor, _res: &Tensor, grad_res: &Tensor) -> candle_core::Result<Option<Tensor>> {
+        let slope = arg.apply_op1_no_bwd(&ClampedArccosDerivative)?;
+        Ok(Some(grad_res.mul(&slope)?))
+    }
+}
+
+impl CustomOp1 for ClampedArccosDerivative {
+    fn name(&self) -> &'static str {
+        "clamped-arccos-derivative"
+    }
+
+    fn cpu_fwd(&self, storage: &CpuStorage, layout: &Layout) -> candle_core::Result<(CpuStorage, Shape)> {
+        map_float(self.name(), storage, layout, derivative)
+    }
+}
+
+/// arccos(clamp(x, −1 + ε, 1 − ε)) of every element, differentiable (see `ClampedArccos`).
+pub fn clamped_arccos(x: &Tensor) -> candle_core::Result<Tensor> {
+    x.apply_op1(ClampedArccos)
+}
+
+/// The geodesic angle θ (radians, in [0, π]) between two 6D rotations (first two matrix
+/// columns, `[..., 6]`), per token: arccos((tr(R̂ᵀR) − 1) / 2), clamped as the reference's
+/// geodesic loss. The 6D values are orthonormalised first (Gram–Schmidt, third column by cross
+/// product), so unnormalised network outputs are fine.
 pub fn rotation_distance(a: &Tensor, b: &Tensor) -> candle_core::Result<Tensor> {
     let frame = |x: &Tensor| -> candle_core::Result<[Tensor; 3]> {
         let last = x.rank() - 1;
@@ -239,13 +336,13 @@ pub fn rotation_distance(a: &Tensor, b: &Tensor) -> candle_core::Result<Tensor> 
     for k in 1..3 {
         trace = (trace + (&fa[k] * &fb[k])?.sum(last)?)?;
     }
-    (trace * -0.5)? + 1.5
+    clamped_arccos(&((trace - 1.0)? * 0.5)?)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diffusion::data::RawClip;
+    use crate::diffusion::data::{Augmentation, RawClip};
     use crate::embed::NameTable;
     use crate::nn::{seeded_var_builder, DenoiserConfig};
     use crate::skeleton::topology;
@@ -253,7 +350,8 @@ mod tests {
     fn set() -> TrainSet {
         let (skeleton, motion) = crate::synth::creature("quadruped", 0).unwrap();
         let clips = vec![RawClip { name: "q.bvh".into(), skeleton, motion }];
-        TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX).unwrap().0
+        // Augmented: the resume test then also covers variant draws.
+        TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &Augmentation::with_seed(2)).unwrap().0
     }
 
     /// Losses of `steps` steps from a fresh model, optionally saving and reloading model and
@@ -300,15 +398,70 @@ mod tests {
     }
 
     #[test]
-    fn rotation_distance_is_zero_for_equal_rotations_and_grows_with_angle() {
+    fn rotation_distance_is_the_geodesic_angle() {
         let dev = Device::Cpu;
         // Identity (columns x, y) and rotations by 90 and 180 degrees about z; 6D are unnormalised.
         let r = |c1: [f32; 3], c2: [f32; 3]| Tensor::from_vec([c1, c2].concat(), (1, 6), &dev).unwrap();
         let id = r([2.0, 0.0, 0.0], [0.3, 1.0, 0.0]);
-        let d = |a: &Tensor, b: &Tensor| rotation_distance(a, b).unwrap().to_vec1::<f32>().unwrap()[0];
-        assert!(d(&id, &id).abs() < 1e-6);
-        assert!((d(&id, &r([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])) - 1.0).abs() < 1e-5, "90 degrees: 1 - cos = 1");
-        assert!((d(&id, &r([-1.0, 0.0, 0.0], [0.0, -1.0, 0.0])) - 2.0).abs() < 1e-5, "180 degrees: 2");
+        let d = |a: &Tensor, b: &Tensor| rotation_distance(a, b).unwrap().to_vec1::<f32>().unwrap()[0] as f64;
+        // Within the clamp: arccos(1 - 1e-6) = 1.4e-3 rad.
+        let edge = (1.0 - ARCCOS_EPSILON).acos();
+        assert!((d(&id, &id) - edge).abs() < 2e-4, "equal rotations: {}", d(&id, &id));
+        assert!((d(&id, &r([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])) - std::f64::consts::FRAC_PI_2).abs() < 1e-5, "90 degrees");
+        assert!((d(&id, &r([-1.0, 0.0, 0.0], [0.0, -1.0, 0.0])) - (std::f64::consts::PI - edge)).abs() < 2e-4, "180 degrees");
+        let c = (0.5f32).cos();
+        let s = (0.5f32).sin();
+        assert!((d(&id, &r([c, s, 0.0], [-s, c, 0.0])) - 0.5).abs() < 1e-4, "0.5 rad");
+    }
+
+    #[test]
+    fn clamped_arccos_gradient_is_finite_and_matches_finite_differences() {
+        let dev = Device::Cpu;
+        let xs = [-0.9f64, -0.3, 0.0, 0.4, 0.95, 0.999];
+        let x = Var::from_vec(xs.to_vec(), xs.len(), &dev).unwrap();
+        let grads = clamped_arccos(x.as_tensor()).unwrap().sum_all().unwrap().backward().unwrap();
+        let g = grads.get(x.as_tensor()).unwrap().to_vec1::<f64>().unwrap();
+        for (&x0, &gx) in xs.iter().zip(&g) {
+            let h = 1e-6;
+            let numeric = ((x0 + h).acos() - (x0 - h).acos()) / (2.0 * h);
+            assert!((gx - numeric).abs() < 1e-5 * numeric.abs().max(1.0), "x = {x0}: {gx} against {numeric}");
+        }
+        // At and beyond the clamp: the angle stays finite and the gradient is 0, never inf/NaN.
+        let x = Var::from_vec(vec![1.0f32, -1.0, 1.5, -3.0], 4, &dev).unwrap();
+        let theta = clamped_arccos(x.as_tensor()).unwrap();
+        assert!(theta.to_vec1::<f32>().unwrap().iter().all(|t| t.is_finite() && (0.0..=std::f32::consts::PI).contains(t)));
+        let g = theta.sum_all().unwrap().backward().unwrap().get(x.as_tensor()).unwrap().to_vec1::<f32>().unwrap();
+        assert_eq!(g, vec![0.0; 4]);
+        // Through the whole rotation distance, against a finite difference in one 6D input.
+        let b = Tensor::from_vec(vec![1.0f64, 0.0, 0.0, 0.0, 1.0, 0.0], (1, 6), &dev).unwrap();
+        let a0 = [0.8f64, 0.5, 0.1, -0.4, 0.9, 0.2];
+        let a = Var::from_vec(a0.to_vec(), (1, 6), &dev).unwrap();
+        let g = rotation_distance(a.as_tensor(), &b).unwrap().sum_all().unwrap().backward().unwrap().get(a.as_tensor()).unwrap().flatten_all().unwrap().to_vec1::<f64>().unwrap();
+        let theta = |v: [f64; 6]| rotation_distance(&Tensor::from_vec(v.to_vec(), (1, 6), &dev).unwrap(), &b).unwrap().to_vec1::<f64>().unwrap()[0];
+        for k in 0..6 {
+            let (mut up, mut down) = (a0, a0);
+            up[k] += 1e-6;
+            down[k] -= 1e-6;
+            let numeric = (theta(up) - theta(down)) / 2e-6;
+            assert!(g[k].is_finite() && (g[k] - numeric).abs() < 1e-4, "component {k}: {} against {numeric}", g[k]);
+        }
+    }
+
+    #[test]
+    fn every_parameter_gets_a_finite_gradient_from_the_training_loss() {
+        let dev = Device::Cpu;
+        let set = set();
+        let varmap = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
+        let loss = training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, 1.0, &dev).unwrap();
+        let grads = loss.backward().unwrap();
+        let vars = named_vars(&varmap);
+        assert!(!vars.is_empty());
+        for (name, var) in &vars {
+            let g = grads.get(var.as_tensor()).unwrap_or_else(|| panic!("{name}: no gradient"));
+            let norm = g.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap();
+            assert!(norm > 0.0 && norm.is_finite(), "{name}: gradient norm {norm}");
+        }
     }
 
     #[test]

@@ -1,0 +1,97 @@
+//! `mo-train` as a process: Ctrl-C / SIGTERM save a checkpoint at a step boundary and exit 130,
+//! and resuming from it ends where the uninterrupted run ends; the augmentation flags and the
+//! recorded skeleton names.
+mod common;
+
+use common::{bin, ok, run, s, tempdir};
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+/// One folder per creature (directories are not searched recursively: both are named).
+fn data(dir: &Path) -> Vec<PathBuf> {
+    ["biped", "quadruped"]
+        .iter()
+        .map(|n| {
+            let folder = dir.join("data").join(n);
+            std::fs::create_dir_all(&folder).unwrap();
+            let from = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data").join(format!("{n}.bvh"));
+            std::fs::copy(from, folder.join(format!("{n}_walk.bvh"))).unwrap();
+            folder
+        })
+        .collect()
+}
+
+fn train_args<'a>(data: &'a [PathBuf], out: &'a Path, steps: &'a str) -> Vec<&'a str> {
+    let mut args: Vec<&str> = data.iter().map(|d| s(d)).collect();
+    args.extend(["--out", s(out), "--preset", "tiny", "--steps", steps, "--batch", "2", "--crop", "12", "--checkpoint-minutes", "1000"]);
+    args
+}
+
+fn info(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("checkpoint.json")).unwrap()).unwrap()
+}
+
+#[cfg(unix)]
+#[test]
+fn a_signal_saves_a_checkpoint_that_resumes_the_same_run() {
+    let dir = tempdir("train-signal");
+    let data = data(&dir);
+    for signal in ["-INT", "-TERM"] {
+        let out = dir.join(format!("run{signal}"));
+        let child = bin("mo-train").args(train_args(&data, &out, "100000")).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+        // Let it take a few steps (the log has a line per step), then interrupt it.
+        let started = Instant::now();
+        let log = out.join("log.jsonl");
+        while std::fs::read_to_string(&log).map_or(0, |t| t.lines().count()) < 3 {
+            assert!(started.elapsed() < Duration::from_secs(120), "mo-train took no steps in 2 minutes");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let killed = std::process::Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap();
+        assert!(killed.success());
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(130), "{signal}: {stderr}");
+        let step = info(&out)["step"].as_u64().unwrap();
+        assert!(step >= 3 && stderr.contains(&format!("interrupted at step {step}, checkpoint saved; --resume to continue")), "{stderr}");
+        assert_eq!(std::fs::read_to_string(&log).unwrap().lines().count() as u64, step, "the checkpoint holds every logged step");
+        let leftovers: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).filter(|n| n.ends_with(".tmp")).collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
+        if signal == "-INT" {
+            // Two more steps after the interruption equal a straight run of as many steps.
+            let total = (step + 2).to_string();
+            let mut resume = train_args(&data, &out, &total);
+            resume.push("--resume");
+            ok(&run("mo-train", &resume, None), "resume");
+            let straight = dir.join("straight");
+            ok(&run("mo-train", &train_args(&data, &straight, &total), None), "straight");
+            assert_eq!(std::fs::read(straight.join("model.safetensors")).unwrap(), std::fs::read(out.join("model.safetensors")).unwrap(), "interrupted + resumed = straight");
+            assert_eq!(std::fs::read(straight.join("optimizer.safetensors")).unwrap(), std::fs::read(out.join("optimizer.safetensors")).unwrap());
+        }
+    }
+}
+
+#[test]
+fn augmentation_flags_and_skeleton_names_are_recorded() {
+    let dir = tempdir("train-augment");
+    let data = data(&dir);
+    let out = dir.join("model");
+    let mut args = train_args(&data, &out, "1");
+    args.extend(["--augment", "1/2", "--augment-variants", "2"]);
+    let result = run("mo-train", &args, None);
+    ok(&result, "augmented");
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(stderr.contains("2 skeletons (biped, quadruped)") && stderr.contains("4 augmented variants"), "{stderr}");
+    let info = info(&out);
+    assert_eq!((info["augment"].as_f64(), info["augment_variants"].as_u64()), (Some(0.5), Some(2)));
+    let names: Vec<&str> = info["skeletons"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["biped", "quadruped"], "one skeleton per folder: named after it");
+    for bad in ["1.5", "-0.1", "2/0", "x"] {
+        let flag = format!("--augment={bad}");
+        let mut args = train_args(&data, &dir, "1");
+        args.push(&flag);
+        let out = run("mo-train", &args, None);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.code() == Some(2) && stderr.contains("'--augment <P>'"), "{bad}: {stderr}");
+    }
+}
