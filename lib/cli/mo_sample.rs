@@ -20,9 +20,9 @@ const EXAMPLES: &str = "\
 EXAMPLES:
     skel-info examples/data/dragon.bvh | mo-sample --model model -n 2 --frames 30 --steps 5 > d.npy
     mo-sample examples/data/spider.bvh --model model --frames 30 --steps 5 --bvh 'spider_{i}.bvh'
-    mo-sample examples/data/quadruped.bvh --model model --steps 5 --reference examples/data/quadruped.bvh --keep-frames 0-19,60-79 --report > inbetween.npy
-    mo-sample examples/data/quadruped.bvh --model model --steps 5 --reference examples/data/quadruped.bvh --keep-joints '*Thigh/,BN_Tail_01/' --bvh 'legs_{i}.bvh'
-    mo-sample examples/data/quadruped.bvh --model model --steps 5 --sampler ddim --reference examples/data/quadruped.bvh --keep-frames 0-9 --keep-joints '*_L_*' -o mixed.npy";
+    mo-sample examples/data/quadruped.bvh --model model --frames 40 --steps 5 --bvh q.bvh
+    mo-sample --reference q.bvh --model model --steps 5 --keep-frames 0-9,30-38 --report > ib.npy
+    mo-sample --reference q.bvh --model model --steps 5 --keep-joints '*Thigh/' --bvh legs.bvh";
 
 /// Generate motion for a skeleton with a trained diffusion model (AnyTop).
 ///
@@ -56,9 +56,9 @@ EXAMPLES:
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-sample", version, after_long_help = EXAMPLES)]
 pub struct Args {
-    /// Skeleton document or BVH ('-' = stdin).
-    #[arg(value_name = "SKELETON", default_value = "-")]
-    pub skeleton: PathBuf,
+    /// Skeleton document or BVH ('-' = stdin) [default: stdin; with --reference: the reference].
+    #[arg(value_name = "SKELETON")]
+    pub skeleton: Option<PathBuf>,
     /// Model directory written by mo-train.
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
@@ -121,7 +121,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
         None => None,
     };
-    let arg = read_skeleton(&args.skeleton)?;
+    let dash = PathBuf::from("-");
+    let arg = read_skeleton(args.skeleton.as_ref().or(args.reference.as_ref()).unwrap_or(&dash))?;
     let skeleton = &arg.skeleton;
     let device = Device::Cpu;
     let loaded = checkpoint::load(model_dir, &device)?;
@@ -245,7 +246,7 @@ fn keep_mask(args: &Args, r: &Reference, skeleton: &crate::skeleton::Skeleton, f
     let mut mask = KeepMask::new(frames, skeleton.len());
     let known = frames.min(r.features.frames);
     if let Some(text) = &args.keep_frames {
-        let why = format!("the output has {frames} frames, the reference {} {} feature frames", r.name, r.features.frames);
+        let why = format!("the output has {frames} frames, the reference {} has {} frames of features", r.name, r.features.frames);
         let ranges = edit::parse_frame_ranges(text, known, &why).context("--keep-frames")?;
         mask.keep_frames(&ranges);
     }

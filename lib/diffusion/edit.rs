@@ -26,7 +26,7 @@ pub enum EditError {
     RangePastEnd { text: String, last: usize, why: String },
     #[error("no joint matches '{pattern}' (closest: {})", closest.join(", "))]
     NoJoint { pattern: String, closest: Vec<String> },
-    #[error("{0}")]
+    #[error(transparent)]
     Lookup(#[from] lookup::LookupError),
     #[error("an empty list of {0}")]
     EmptyList(&'static str),
