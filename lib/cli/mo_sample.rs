@@ -51,8 +51,9 @@ EXAMPLES:
 /// --report prints one JSON line on stderr: per sample, the velocity jump at every seam
 /// between kept and generated frames (mean over joints of the largest change of a joint's
 /// velocity at the boundary, BVH units per frame), next to the distribution of the same
-/// number over every frame boundary of the reference clip (median, p95, max). A seam jump
-/// no larger than the reference's p95 is as continuous as the clip itself.
+/// number over every frame boundary of the reference clip (median, p95, max) and over the
+/// boundaries inside the generated frames. A seam jump no larger than the reference's p95 is
+/// as continuous as the clip itself.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-sample", version, after_long_help = EXAMPLES)]
 pub struct Args {
@@ -275,9 +276,15 @@ fn seam_report(
     let kept = mask.whole_frames();
     let mut rows = Vec::with_capacity(samples.len());
     for f in samples {
-        let seams = edit::seam_jump(&positions(f)?, j, &kept);
+        let p = positions(f)?;
+        let seams = edit::seam_jump(&p, j, &kept);
         let max = seams.iter().map(|s| s.jump).fold(0.0, f64::max);
-        rows.push(serde_json::json!({ "seams": seams, "max_seam_jump": max }));
+        // The same number inside the generated stretch (boundaries between two generated
+        // frames): a seam as smooth as the model's own motion matches it.
+        let jumps = edit::boundary_jumps(&p, j);
+        let inside: Vec<f64> = (1..kept.len()).filter(|&b| !kept[b] && !kept[b - 1]).filter_map(|b| jumps.get(b - 1).copied()).collect();
+        let generated = edit::jump_distribution_of(inside);
+        rows.push(serde_json::json!({ "seams": seams, "max_seam_jump": max, "generated_jumps": generated }));
     }
     let report = serde_json::json!({
         "report": "seam_jump",

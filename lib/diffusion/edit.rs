@@ -270,7 +270,12 @@ pub struct JumpDistribution {
 /// The distribution of velocity jumps over every frame boundary of `clips` (each: positions
 /// `[frame * joints + joint]` and its joint count); `None` without any boundary.
 pub fn jump_distribution<'a>(clips: impl IntoIterator<Item = (&'a [DVec3], usize)>) -> Option<JumpDistribution> {
-    let mut all: Vec<f64> = clips.into_iter().flat_map(|(p, j)| boundary_jumps(p, j)).filter(|v| v.is_finite()).collect();
+    jump_distribution_of(clips.into_iter().flat_map(|(p, j)| boundary_jumps(p, j)).collect())
+}
+
+/// The distribution of some `boundary_jumps` values (non-finite ones ignored); `None` if none.
+pub fn jump_distribution_of(values: Vec<f64>) -> Option<JumpDistribution> {
+    let mut all: Vec<f64> = values.into_iter().filter(|v| v.is_finite()).collect();
     if all.is_empty() {
         return None;
     }
