@@ -41,9 +41,11 @@ EXAMPLES:
 ///
 /// Editing (AnyTop §5): --reference names a clip of the same skeleton; --keep-frames keeps
 /// whole frames of it (in-betweening: '0-19,100-119' generates the frames between) and
-/// --keep-joints keeps joints over all its frames (body-part editing: '*Thigh/' keeps the legs,
-/// generates the rest); both together keep the union. The kept part is imposed at every
-/// diffusion step, and the output's kept values are the reference's exactly. The output has
+/// --keep-joints keeps joints over all its frames (body-part editing: '*Thigh/' keeps the thighs
+/// and all below them, generates the rest); both together keep the union. The kept part is
+/// imposed at every diffusion step, and the output's kept values are the reference's exactly.
+/// Only the joints named are kept: a kept leg whose root is generated moves with the generated
+/// root (positions are root-relative), so add the root to keep the legs in place. The output has
 /// the reference's length (its BVH frames minus one: AnyTop features drop the last frame)
 /// unless --frames or --seconds says otherwise; frames past the reference's end are generated.
 /// BVH output stands where the reference stood.
