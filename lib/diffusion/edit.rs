@@ -219,7 +219,7 @@ pub fn sample_edit(
 /// large value at its boundary; `positions` are `[frame * joints + joint]`. Clips shorter than
 /// three frames have no velocity change: empty.
 pub fn boundary_jumps(positions: &[DVec3], joints: usize) -> Vec<f64> {
-    let frames = if joints == 0 { 0 } else { positions.len() / joints };
+    let frames = positions.len().checked_div(joints).unwrap_or(0);
     if frames < 3 {
         return Vec::new();
     }
