@@ -1,14 +1,18 @@
 complete -c mo-sample -l model -d 'Model directory written by mo-train' -r -F
 complete -c mo-sample -s n -l samples -d 'Number of samples' -r
-complete -c mo-sample -l frames -d 'Frames per sample' -r
+complete -c mo-sample -l frames -d 'Frames per sample [default: 120; with --reference: the reference\'s length]' -r
 complete -c mo-sample -l seconds -d 'Length in seconds (at the skeleton\'s frame rate)' -r
 complete -c mo-sample -l steps -d 'Diffusion steps to visit (1..=100)' -r
 complete -c mo-sample -l sampler -d 'Sampler' -r -f -a "ddpm\t''
 ddim\t''"
 complete -c mo-sample -l bvh -d 'Write BVH files instead of NPY (\'{i}\' becomes the sample index)' -r -F
+complete -c mo-sample -l reference -d 'A clip of the same skeleton (BVH) to keep parts of (needs --keep-frames or --keep-joints)' -r -F
+complete -c mo-sample -l keep-frames -d 'In-betweening: output frames taken from the reference, e.g. \'0-19,100-119\' (inclusive)' -r
+complete -c mo-sample -l keep-joints -d 'Body-part editing: joints taken from the reference: names or globs (\'*Leg*\'), \'Name/\' for a joint and all its descendants, comma-separated' -r
 complete -c mo-sample -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-sample -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-sample -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-sample -l report -d 'Print seam continuity as one JSON line on stderr (with --reference)'
 complete -c mo-sample -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-sample -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-sample -s h -l help -d 'Print help (see more with \'--help\')'

@@ -3,6 +3,7 @@
 use crate::cli::load::{is_dash, read_skeleton};
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
+use crate::diffusion::edit::{self, KeepMask};
 use crate::diffusion::sample::{sample, Condition, SampleOptions};
 use crate::diffusion::{Sampler, Schedule};
 use crate::embed::NameTable;
@@ -18,7 +19,10 @@ use std::path::PathBuf;
 const EXAMPLES: &str = "\
 EXAMPLES:
     skel-info examples/data/dragon.bvh | mo-sample --model model -n 2 --frames 30 --steps 5 > d.npy
-    mo-sample examples/data/spider.bvh --model model --frames 30 --steps 5 --bvh 'spider_{i}.bvh'";
+    mo-sample examples/data/spider.bvh --model model --frames 30 --steps 5 --bvh 'spider_{i}.bvh'
+    mo-sample examples/data/quadruped.bvh --model model --frames 40 --steps 5 --bvh q.bvh
+    mo-sample --reference q.bvh --model model --steps 5 --keep-frames 0-9,30-38 --report > ib.npy
+    mo-sample --reference q.bvh --model model --steps 5 --keep-joints '*Thigh/' --bvh legs.bvh";
 
 /// Generate motion for a skeleton with a trained diffusion model (AnyTop).
 ///
@@ -34,21 +38,39 @@ EXAMPLES:
 ///
 /// Sampling: --steps 100 with --sampler ddpm is the reference's full ancestral loop; fewer steps
 /// respace it (or use ddim) for speed. The same seed, model and input give the same output.
+///
+/// Editing (AnyTop §5): --reference names a clip of the same skeleton; --keep-frames keeps
+/// whole frames of it (in-betweening: '0-19,100-119' generates the frames between) and
+/// --keep-joints keeps joints over all its frames (body-part editing: '*Thigh/' keeps the thighs
+/// and all below them, generates the rest); both together keep the union. The kept part is
+/// imposed at every diffusion step, and the output's kept values are the reference's exactly.
+/// Only the joints named are kept: a kept leg whose root is generated moves with the generated
+/// root (positions are root-relative), so add the root to keep the legs in place. The output has
+/// the reference's length (its BVH frames minus one: AnyTop features drop the last frame)
+/// unless --frames or --seconds says otherwise; frames past the reference's end are generated.
+/// BVH output stands where the reference stood.
+///
+/// --report prints one JSON line on stderr: per sample, the velocity jump at every seam
+/// between kept and generated frames (mean over joints of the largest change of a joint's
+/// velocity at the boundary, BVH units per frame), next to the distribution of the same
+/// number over every frame boundary of the reference clip (median, p95, max) and over the
+/// boundaries inside the generated frames. A seam jump no larger than the reference's p95 is
+/// as continuous as the clip itself.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-sample", version, after_long_help = EXAMPLES)]
 pub struct Args {
-    /// Skeleton document or BVH ('-' = stdin).
-    #[arg(value_name = "SKELETON", default_value = "-")]
-    pub skeleton: PathBuf,
+    /// Skeleton document or BVH ('-' = stdin) [default: stdin; with --reference: the reference].
+    #[arg(value_name = "SKELETON")]
+    pub skeleton: Option<PathBuf>,
     /// Model directory written by mo-train.
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
     /// Number of samples.
     #[arg(short = 'n', long = "samples", value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub samples: u64,
-    /// Frames per sample.
-    #[arg(long, value_name = "N", default_value_t = 120, value_parser = clap::value_parser!(u64).range(1..=10_000), conflicts_with = "seconds")]
-    pub frames: u64,
+    /// Frames per sample [default: 120; with --reference: the reference's length].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000), conflicts_with = "seconds")]
+    pub frames: Option<u64>,
     /// Length in seconds (at the skeleton's frame rate).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
@@ -61,8 +83,29 @@ pub struct Args {
     /// Write BVH files instead of NPY ('{i}' becomes the sample index).
     #[arg(long, value_name = "PATTERN")]
     pub bvh: Option<PathBuf>,
+    /// A clip of the same skeleton (BVH) to keep parts of (needs --keep-frames or --keep-joints).
+    #[arg(long, value_name = "REF.bvh")]
+    pub reference: Option<PathBuf>,
+    /// In-betweening: output frames taken from the reference, e.g. '0-19,100-119' (inclusive).
+    #[arg(long, value_name = "RANGES", requires = "reference")]
+    pub keep_frames: Option<String>,
+    /// Body-part editing: joints taken from the reference: names or globs ('*Leg*'), 'Name/' for
+    /// a joint and all its descendants, comma-separated.
+    #[arg(long, value_name = "LIST", requires = "reference")]
+    pub keep_joints: Option<String>,
+    /// Print seam continuity as one JSON line on stderr (with --reference).
+    #[arg(long, requires = "reference")]
+    pub report: bool,
     #[command(flatten)]
     pub common: CommonOpts,
+}
+
+/// The reference clip of an edit, encoded on the sampled skeleton's rig.
+struct Reference {
+    name: String,
+    /// Physical units, `[bvh frames − 1, joints, 13]`.
+    features: Features,
+    placement: crate::repr::anytop::Placement,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,16 +125,34 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
         None => None,
     };
-    let arg = read_skeleton(&args.skeleton)?;
+    let dash = PathBuf::from("-");
+    let arg = read_skeleton(args.skeleton.as_ref().or(args.reference.as_ref()).unwrap_or(&dash))?;
     let skeleton = &arg.skeleton;
     let device = Device::Cpu;
     let loaded = checkpoint::load(model_dir, &device)?;
     let section = arg.record()?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
+    let reference = match &args.reference {
+        Some(path) => {
+            if args.keep_frames.is_none() && args.keep_joints.is_none() {
+                bail!("--reference needs --keep-frames RANGES or --keep-joints LIST (what to keep of it)");
+            }
+            Some(read_reference(path, &arg.name, skeleton, &section.rig)?)
+        }
+        None => None,
+    };
     let frames = match args.seconds {
         Some(s) if s.is_finite() && s > 0.0 => ((s * fps).round() as usize).max(1),
         Some(s) => bail!("--seconds must be a positive number, found {s}"),
-        None => args.frames as usize,
+        None => match (args.frames, &reference) {
+            (Some(n), _) => n as usize,
+            (None, Some(r)) => r.features.frames,
+            (None, None) => 120,
+        },
+    };
+    let mask = match &reference {
+        Some(r) => Some(keep_mask(args, r, skeleton, frames)?),
+        None => None,
     };
 
     let stats = match checkpoint::find_trained(&loaded.info.skeletons, skeleton) {
@@ -119,14 +180,29 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let schedule = Schedule::cosine(loaded.info.schedule_steps);
     let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler, seed: args.common.seed };
     let started = std::time::Instant::now();
-    let samples = sample(&loaded.model, &schedule, &cond, &opts, &device)?;
+    let samples = match (&reference, &mask) {
+        (Some(r), Some(mask)) => {
+            // Frames past the reference's end are generated; their reference values are unused.
+            let mut padded = r.features.clone();
+            if padded.frames < frames {
+                padded.data.resize(frames * padded.joints * padded.dims, 0.0);
+                padded.frames = frames;
+            }
+            edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &padded, mask, &device)?
+        }
+        _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
+    };
+    if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {
+        eprintln!("{}", seam_report(&section.rig, skeleton, r, mask, &samples)?);
+    }
     if args.common.verbose {
         eprintln!("mo-sample: {count} x {frames} frames in {:.2} s", started.elapsed().as_secs_f64());
     }
 
     match outputs {
         Some(paths) => {
-            let placement = section.rig.rest_placement();
+            // An edit stands where its reference stood, so kept frames land on the reference's.
+            let placement = reference.as_ref().map_or_else(|| section.rig.rest_placement(), |r| r.placement);
             let mut texts = Vec::with_capacity(count);
             for (i, f) in samples.iter().enumerate() {
                 let motion = section.rig.decode_ik(skeleton, f, &placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
@@ -148,6 +224,81 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Read and encode `--reference` on the rig of the skeleton being sampled.
+fn read_reference(path: &std::path::Path, skeleton_name: &str, skeleton: &crate::skeleton::Skeleton, rig: &crate::repr::anytop::AnyTopRig) -> anyhow::Result<Reference> {
+    let name = io::display_name(path);
+    let bytes = io::read_input(path).with_context(|| format!("cannot read the reference {name}"))?;
+    let parsed = bvh::parse_bytes(&bytes, &name).with_context(|| format!("the reference {name}"))?;
+    let own = crate::skeleton::Skeleton::from_bvh(&parsed);
+    own.validate().with_context(|| name.clone())?;
+    if let Some(diff) = skeleton.first_difference(&own) {
+        bail!("the reference {name} is not on the skeleton of {skeleton_name}: {diff}");
+    }
+    let motion = crate::motion::Motion::from_bvh(&parsed, &own);
+    if motion.frames < 2 {
+        bail!("the reference {name} has {} frame(s); AnyTop features need at least 2", motion.frames);
+    }
+    let encoded = rig.encode(skeleton, &motion).map_err(|e| anyhow::anyhow!("the reference {name}: {e}"))?;
+    Ok(Reference { name, features: encoded.features, placement: encoded.placement })
+}
+
+/// The cells `--keep-frames` and `--keep-joints` keep: frames must exist in both the output and
+/// the reference; joints are kept over every output frame the reference has.
+fn keep_mask(args: &Args, r: &Reference, skeleton: &crate::skeleton::Skeleton, frames: usize) -> anyhow::Result<KeepMask> {
+    let mut mask = KeepMask::new(frames, skeleton.len());
+    let known = frames.min(r.features.frames);
+    if let Some(text) = &args.keep_frames {
+        let why = format!("the output has {frames} frames, the reference {} has {} frames of features", r.name, r.features.frames);
+        let ranges = edit::parse_frame_ranges(text, known, &why).context("--keep-frames")?;
+        mask.keep_frames(&ranges);
+    }
+    if let Some(list) = &args.keep_joints {
+        let joints = edit::select_joints(skeleton, list).context("--keep-joints")?;
+        mask.keep_joints(&joints, 0..known);
+    }
+    if mask.count() == mask.keep.len() {
+        bail!("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate");
+    }
+    Ok(mask)
+}
+
+/// `--report`: seam jumps per sample against the reference clip's own distribution (one JSON line).
+fn seam_report(
+    rig: &crate::repr::anytop::AnyTopRig,
+    skeleton: &crate::skeleton::Skeleton,
+    r: &Reference,
+    mask: &KeepMask,
+    samples: &[Features],
+) -> anyhow::Result<String> {
+    let j = skeleton.len();
+    let positions = |f: &Features| rig.recover_positions(skeleton, f, &r.placement).map_err(|e| anyhow::anyhow!("--report: {e}"));
+    let reference = positions(&r.features)?;
+    let distribution = edit::jump_distribution([(reference.as_slice(), j)]);
+    let kept = mask.whole_frames();
+    let mut rows = Vec::with_capacity(samples.len());
+    for f in samples {
+        let p = positions(f)?;
+        let seams = edit::seam_jump(&p, j, &kept);
+        let max = seams.iter().map(|s| s.jump).fold(0.0, f64::max);
+        // The same number inside the generated stretch (boundaries between two generated
+        // frames): a seam as smooth as the model's own motion matches it.
+        let jumps = edit::boundary_jumps(&p, j);
+        let inside: Vec<f64> = (1..kept.len()).filter(|&b| !kept[b] && !kept[b - 1]).filter_map(|b| jumps.get(b - 1).copied()).collect();
+        let generated = edit::jump_distribution_of(inside);
+        rows.push(serde_json::json!({ "seams": seams, "max_seam_jump": max, "generated_jumps": generated }));
+    }
+    let report = serde_json::json!({
+        "report": "seam_jump",
+        "units": "BVH units per frame",
+        "reference": r.name,
+        "kept_frames": kept.iter().filter(|&&k| k).count(),
+        "kept_cells": mask.count(),
+        "reference_jumps": distribution,
+        "samples": rows,
+    });
+    Ok(report.to_string())
 }
 
 /// Statistics for a skeleton nobody measured: its rest-pose row as the mean, and the average

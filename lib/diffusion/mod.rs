@@ -3,6 +3,7 @@
 
 pub mod checkpoint;
 pub mod data;
+pub mod edit;
 pub mod sample;
 pub mod schedule;
 pub mod train;

@@ -32,14 +32,65 @@ pub struct SampleOptions {
 
 /// `samples` motions, denormalised AnyTop features `[frames, joints, 13]` each.
 pub fn sample(model: &Denoiser, schedule: &Schedule, cond: &Condition, opts: &SampleOptions, device: &Device) -> anyhow::Result<Vec<Features>> {
+    let mut x = denoise(model, schedule, cond, opts, None, device)?;
+    for f in &mut x {
+        cond.stats.denormalise(f).map_err(|e| anyhow::anyhow!("denormalising the samples: {e}"))?;
+    }
+    Ok(x)
+}
+
+/// A known part of the motion, imposed at every step (`edit.rs`): normalised reference values
+/// for the whole `[frames, joints, 13]` block, and which elements are known.
+pub(super) struct Imposed<'a> {
+    pub reference: &'a [f32],
+    /// Per element of the block (all 13 features of a kept joint-frame are kept).
+    pub known: &'a [bool],
+    /// Seeds the noise the known part is diffused with, a stream apart from the sampler's own
+    /// so that nothing known leaves the generated part's noise as plain sampling draws it.
+    pub seed: u64,
+}
+
+/// The sampling loop, in normalised units. With a known part, the model's input x_t carries
+/// the reference noised to step t (q_sample) at the known elements, and its x0 prediction is
+/// overridden there by the reference (AnyTop §5; the upstream passes zeros as the reference),
+/// so the generated part is denoised next to the motion it has to join.
+pub(super) fn denoise(
+    model: &Denoiser,
+    schedule: &Schedule,
+    cond: &Condition,
+    opts: &SampleOptions,
+    imposed: Option<&Imposed>,
+    device: &Device,
+) -> anyhow::Result<Vec<Features>> {
     let joints = cond.names.len();
     let dims = model.config().feature_dims;
     let per = opts.frames * joints * dims;
+    if let Some(k) = imposed {
+        anyhow::ensure!(
+            k.reference.len() == per && k.known.len() == per,
+            "the known motion has {} values and {} flags; sampling {} frames x {joints} joints x {dims} needs {per}",
+            k.reference.len(),
+            k.known.len(),
+            opts.frames
+        );
+    }
     let mut rng = SplitMix64::new(opts.seed);
+    let mut known_rng = imposed.map(|k| SplitMix64::new(k.seed));
+    let known_count = imposed.map_or(0, |k| k.known.iter().filter(|&&b| b).count());
     let mut x: Vec<Features> =
         (0..opts.samples).map(|_| Features { frames: opts.frames, joints, dims, data: gaussian(&mut rng, per) }).collect();
     let timesteps = schedule.timesteps(opts.steps);
     for step in schedule.steps(&timesteps, opts.sampler) {
+        if let (Some(k), Some(krng)) = (imposed, known_rng.as_mut()) {
+            let (a, b) = schedule.noise_coefficients(step.t);
+            for f in x.iter_mut() {
+                let eps = gaussian(krng, known_count);
+                let mut e = eps.iter();
+                for ((v, &r), _) in f.data.iter_mut().zip(k.reference).zip(k.known).filter(|(_, kn)| **kn) {
+                    *v = (a * r as f64 + b * e.next().copied().unwrap_or(0.0) as f64) as f32;
+                }
+            }
+        }
         let items: Vec<BatchItem> = x
             .iter()
             .map(|f| BatchItem { features: f, rest_row: cond.rest_row, relations: cond.relations, distances: cond.distances, names: cond.names, start: 0 })
@@ -47,7 +98,14 @@ pub fn sample(model: &Denoiser, schedule: &Schedule, cond: &Condition, opts: &Sa
         let batch = batch_from(&items, &vec![step.t as u32; items.len()], device)?;
         let predicted = model.forward(&batch)?;
         let t = opts.frames + 1;
-        let x0: Vec<f32> = predicted.narrow(1, 1, t - 1)?.contiguous()?.flatten_all()?.to_vec1()?;
+        let mut x0: Vec<f32> = predicted.narrow(1, 1, t - 1)?.contiguous()?.flatten_all()?.to_vec1()?;
+        if let Some(k) = imposed {
+            for chunk in x0.chunks_exact_mut(per.max(1)) {
+                for ((v, &r), _) in chunk.iter_mut().zip(k.reference).zip(k.known).filter(|(_, kn)| **kn) {
+                    *v = r;
+                }
+            }
+        }
         for (i, f) in x.iter_mut().enumerate() {
             let noise = if step.sigma > 0.0 { gaussian(&mut rng, per) } else { Vec::new() };
             for k in 0..per {
@@ -56,8 +114,14 @@ pub fn sample(model: &Denoiser, schedule: &Schedule, cond: &Condition, opts: &Sa
             }
         }
     }
-    for f in &mut x {
-        cond.stats.denormalise(f).map_err(|e| anyhow::anyhow!("denormalising the samples: {e}"))?;
+    // The last step lands on x̂0, which carries the reference; set it again so that no sampler
+    // coefficient's rounding can leave a known value off.
+    if let Some(k) = imposed {
+        for f in x.iter_mut() {
+            for ((v, &r), _) in f.data.iter_mut().zip(k.reference).zip(k.known).filter(|(_, kn)| **kn) {
+                *v = r;
+            }
+        }
     }
     Ok(x)
 }

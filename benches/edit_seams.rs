@@ -1,0 +1,105 @@
+//! In-betweening continuity with a trained model: the velocity jump at the seams between kept
+//! and generated frames (`diffusion::edit::seam_jump`), for the known motion imposed at every
+//! step (ours) against two baselines — plain sampling with the reference's frames pasted in
+//! afterwards, and the upstream's editing, which imposes zeros (the mean pose) instead of the
+//! reference (reference/anytop.md §5), pasted afterwards too. Next to: the same statistic
+//! inside the generated frames and over the reference clip itself (the training data).
+//!
+//!     MENAGERIE_EDIT_MODEL=/tmp/edit_model cargo bench --bench edit_seams
+//!
+//! (a model from `mo-train examples/data --out /tmp/edit_model --preset tiny --steps 300 ...`;
+//! optional MENAGERIE_EDIT_CLIP = a BVH of a trained skeleton, default examples/data/quadruped.bvh,
+//! kept frames: the first and last quarter).
+use candle_core::Device;
+use menagerie::cli::load::read_skeleton;
+use menagerie::diffusion::edit::{boundary_jumps, jump_distribution, jump_distribution_of, sample_edit, seam_jump, KeepMask};
+use menagerie::diffusion::sample::{sample, Condition, SampleOptions};
+use menagerie::diffusion::{checkpoint, Sampler, Schedule};
+use menagerie::embed::NameTable;
+use menagerie::repr::Features;
+use menagerie::skeleton::topology;
+use std::path::PathBuf;
+
+fn main() {
+    let Some(model_dir) = std::env::var_os("MENAGERIE_EDIT_MODEL").map(PathBuf::from) else {
+        println!("SKIP edit_seams: set MENAGERIE_EDIT_MODEL to a mo-train model directory");
+        return;
+    };
+    let clip = std::env::var_os("MENAGERIE_EDIT_CLIP")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/data/quadruped.bvh"));
+    let device = Device::Cpu;
+    let loaded = checkpoint::load(&model_dir, &device).expect("model");
+    let arg = read_skeleton(&clip).expect("clip");
+    let skeleton = &arg.skeleton;
+    let section = arg.record().expect("rig");
+    let Some(trained) = loaded.info.skeletons.iter().find(|t| t.matches(skeleton)) else {
+        println!("SKIP edit_seams: {} is not a skeleton the model was trained on", clip.display());
+        return;
+    };
+    let stats = trained.stats.clone();
+    let encoded = section.rig.encode(skeleton, arg.motion.as_ref().unwrap()).expect("encode");
+    let reference = encoded.features;
+    let (frames, j) = (reference.frames, reference.joints);
+    let mut rest = Features { frames: 1, joints: j, dims: 13, data: section.rest_row.concat() };
+    stats.normalise(&mut rest).unwrap();
+    let names = NameTable::builtin().unwrap().embed_skeleton(skeleton);
+    let relations = topology::relations(skeleton);
+    let distances = topology::distances(skeleton, loaded.info.dmax);
+    let cond = Condition { rest_row: &rest.data, relations: &relations, distances: &distances, names: &names, stats: &stats };
+    let schedule = Schedule::cosine(loaded.info.schedule_steps);
+
+    let quarter = frames / 4;
+    let mut mask = KeepMask::new(frames, j);
+    mask.keep_frames(&[0..quarter, frames - quarter..frames]);
+    let kept = mask.whole_frames();
+    let positions = |f: &Features| section.rig.recover_positions(skeleton, f, &encoded.placement).unwrap();
+    let data = jump_distribution([(positions(&reference).as_slice(), j)]).unwrap();
+    let paste = |mut f: Features| {
+        for (k, v) in f.data.iter_mut().enumerate() {
+            if mask.keep[k / 13] {
+                *v = reference.data[k];
+            }
+        }
+        f
+    };
+    let zeros = Features { frames, joints: j, dims: 13, data: stats.mean.iter().copied().cycle().take(frames * j * 13).collect() };
+
+    println!("{} ({frames} frames, {j} joints), kept 0..{quarter} and {}..{frames}; model {} (step {})", clip.display(), frames - quarter, model_dir.display(), loaded.info.step);
+    println!("reference clip: boundary jumps median {:.4}, p95 {:.4}, max {:.4} (BVH units/frame)", data.median, data.p95, data.max);
+    println!();
+    println!("| method | sampler | seams median | seams max | seams <= data p95 | inside generated median | inside p95 | seconds |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let n = 8;
+    for (sampler, steps) in [(Sampler::Ddim, 20), (Sampler::Ddpm, 100)] {
+        let opts = SampleOptions { samples: n, frames, steps, sampler, seed: 1 };
+        for method in ["imposed every step", "paste after sampling", "upstream (zeros), pasted"] {
+            let started = std::time::Instant::now();
+            let out: Vec<Features> = match method {
+                "imposed every step" => sample_edit(&loaded.model, &schedule, &cond, &opts, &reference, &mask, &device).unwrap(),
+                "paste after sampling" => sample(&loaded.model, &schedule, &cond, &opts, &device).unwrap().into_iter().map(paste).collect(),
+                _ => sample_edit(&loaded.model, &schedule, &cond, &opts, &zeros, &mask, &device).unwrap().into_iter().map(paste).collect(),
+            };
+            let seconds = started.elapsed().as_secs_f64();
+            let mut seams = Vec::new();
+            let mut inside = Vec::new();
+            for f in &out {
+                let p = positions(f);
+                seams.extend(seam_jump(&p, j, &kept).iter().map(|s| s.jump));
+                let jumps = boundary_jumps(&p, j);
+                inside.extend((1..frames).filter(|&b| !kept[b] && !kept[b - 1]).map(|b| jumps[b - 1]));
+            }
+            let within = seams.iter().filter(|&&s| s <= data.p95).count();
+            let s = jump_distribution_of(seams.clone()).unwrap();
+            let g = jump_distribution_of(inside).unwrap();
+            println!(
+                "| {method} | {sampler:?} {steps} | {:.4} | {:.4} | {within}/{} | {:.4} | {:.4} | {seconds:.1} |",
+                s.median,
+                s.max,
+                seams.len(),
+                g.median,
+                g.p95
+            );
+        }
+    }
+}
