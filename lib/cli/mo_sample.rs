@@ -18,6 +18,8 @@ use std::path::PathBuf;
 
 const EXAMPLES: &str = "\
 EXAMPLES:
+    skel-info examples/data/quadruped.bvh | mo-sample -n 4 > out.npy
+    mo-sample examples/data/dragon.bvh -n 2 --seconds 2 --bvh 'dragon_{i}.bvh'
     skel-info examples/data/dragon.bvh | mo-sample --model model -n 2 --frames 30 --steps 5 > d.npy
     mo-sample examples/data/spider.bvh --model model --frames 30 --steps 5 --bvh 'spider_{i}.bvh'
     mo-sample examples/data/quadruped.bvh --model model --frames 40 --steps 5 --bvh q.bvh
@@ -36,8 +38,10 @@ EXAMPLES:
 /// document's own statistics (skel-info of a BVH with motion); else the rest-pose row as mean and
 /// the trained skeletons' average spreads (said on stderr).
 ///
-/// Sampling: --steps 100 with --sampler ddpm is the reference's full ancestral loop; fewer steps
-/// respace it (or use ddim) for speed. The same seed, model and input give the same output.
+/// Sampling: the default, 10 DDIM steps, keeps `mo-sample -n 4` of a 40-joint creature under
+/// 10 s on two slow cores; --steps 100 --sampler ddpm is the reference's full ancestral loop
+/// (fewer ddpm steps respace it). Quality against steps: models/zoo-small/MODEL_CARD.md. The
+/// same seed, model and input give the same output.
 ///
 /// Editing (AnyTop §5): --reference names a clip of the same skeleton; --keep-frames keeps
 /// whole frames of it (in-betweening: '0-19,100-119' generates the frames between) and
@@ -62,7 +66,8 @@ pub struct Args {
     /// Skeleton document or BVH ('-' = stdin) [default: stdin; with --reference: the reference].
     #[arg(value_name = "SKELETON")]
     pub skeleton: Option<PathBuf>,
-    /// Model directory written by mo-train.
+    /// Model directory written by mo-train [default: the built-in model, a small denoiser
+    /// trained on the synthetic zoo; see models/zoo-small/MODEL_CARD.md].
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
     /// Number of samples.
@@ -75,10 +80,10 @@ pub struct Args {
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
     /// Diffusion steps to visit (1..=100).
-    #[arg(long, value_name = "N", default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..=100))]
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=100))]
     pub steps: u64,
     /// Sampler.
-    #[arg(long, value_enum, default_value_t = SamplerArg::Ddpm)]
+    #[arg(long, value_enum, default_value_t = SamplerArg::Ddim)]
     pub sampler: SamplerArg,
     /// Write BVH files instead of NPY ('{i}' becomes the sample index).
     #[arg(long, value_name = "PATTERN")]
@@ -117,9 +122,6 @@ pub enum SamplerArg {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
     crate::nn::keep_freed_memory();
-    let Some(model_dir) = &args.model else {
-        bail!("--model DIR is needed: no default model ships yet (train one with mo-train)");
-    };
     let count = args.samples as usize;
     let outputs: Option<Vec<PathBuf>> = match &args.bvh {
         Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
@@ -129,7 +131,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let arg = read_skeleton(args.skeleton.as_ref().or(args.reference.as_ref()).unwrap_or(&dash))?;
     let skeleton = &arg.skeleton;
     let device = Device::Cpu;
-    let loaded = checkpoint::load(model_dir, &device)?;
+    let loaded = match &args.model {
+        Some(dir) => checkpoint::load(dir, &device)?,
+        None => checkpoint::load_default(&device)?,
+    };
     let section = arg.record()?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     let reference = match &args.reference {

@@ -105,18 +105,42 @@ pub struct Loaded {
 /// Load `dir`'s info and model (the optimiser separately, with `load_optimizer`).
 pub fn load(dir: &Path, device: &Device) -> anyhow::Result<Loaded> {
     let path = dir.join("checkpoint.json");
-    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
-    let info: CheckpointInfo = serde_json::from_str(&text).with_context(|| format!("{}: not a checkpoint description", path.display()))?;
+    let text = std::fs::read(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
+    let weights = dir.join("model.safetensors");
+    let bytes = std::fs::read(&weights).with_context(|| format!("cannot read {}", weights.display()))?;
+    load_bytes(&text, &bytes, device).with_context(|| format!("model {}", dir.display()))
+}
+
+/// A checkpoint from the bytes of its `checkpoint.json` and `model.safetensors` (the embedded
+/// default model has no directory).
+pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Loaded> {
+    let info: CheckpointInfo = serde_json::from_slice(info_json).context("checkpoint.json: not a checkpoint description")?;
     if info.format != FORMAT || info.version != VERSION {
-        bail!("{}: format {} version {}, expected {FORMAT} version {VERSION}", path.display(), info.format, info.version);
+        bail!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version);
     }
     let varmap = VarMap::new();
-    // Build every parameter (the seed does not matter: all are overwritten), then load.
+    // Build every parameter (the seed does not matter: all are overwritten), then fill them.
     let model = Denoiser::new(seeded_var_builder(&varmap, 0, device), &info.config)?;
-    let mut varmap = varmap;
-    let weights = dir.join("model.safetensors");
-    varmap.load(&weights).with_context(|| format!("cannot load {}", weights.display()))?;
+    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
+    {
+        let vars = varmap.data().lock().map_err(|_| anyhow::anyhow!("the parameter map is poisoned"))?;
+        for (name, var) in vars.iter() {
+            let Some(t) = tensors.get(name) else { bail!("model.safetensors: parameter {name} is missing") };
+            if t.dims() != var.dims() {
+                bail!("model.safetensors: parameter {name} is {:?}, the config needs {:?}", t.dims(), var.dims());
+            }
+            var.set(t).with_context(|| format!("model.safetensors: parameter {name}"))?;
+        }
+    }
     Ok(Loaded { info, varmap, model })
+}
+
+/// The default model that ships inside the binaries: a `small` denoiser trained on the
+/// synthetic zoo (models/zoo-small, see its MODEL_CARD.md).
+pub fn load_default(device: &Device) -> anyhow::Result<Loaded> {
+    const INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
+    const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");
+    load_bytes(INFO, WEIGHTS, device).context("the built-in default model")
 }
 
 /// The optimiser state saved beside a checkpoint.
