@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+"""Generation metrics of a diffusion model per skeleton, against baselines, as markdown tables.
+
+For each skeleton folder (one skeleton's clips, e.g. a synthetic-zoo folder written by
+`cargo run --release --example zoo -- --training DIR`), this samples N motions with each model
+(`mo-sample`, the folder's first clip as the skeleton) and compares them with the folder's clips
+(`mo-metrics generation`). Baselines: the clips themselves (`gt`), and whatever models are named
+(e.g. an untrained checkpoint). With --steps-table it also measures one skeleton's quality and
+wall time against sampling steps.
+
+    tools/eval_generation.py --bin target/release --model zoo=models/zoo-small \\
+        --model untrained=/tmp/untrained --skeletons /work/zoo/quadruped_v0 /work/zoo/dragon_v7
+
+Only our binaries are run; numbers are printed, nothing is written outside a temp dir.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+METRICS = [
+    ("coverage", "coverage %"),
+    ("local_diversity", "local div"),
+    ("inter_diversity", "inter div"),
+    ("intra_diversity_diff", "intra-div diff"),
+]
+
+
+def run(cmd, stdout=None):
+    res = subprocess.run(cmd, stdout=stdout or subprocess.PIPE, stderr=subprocess.PIPE)
+    if res.returncode != 0:
+        sys.exit(f"{' '.join(cmd)} failed: {res.stderr.decode().strip()}")
+    return res.stdout
+
+
+def clips(folder):
+    return sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".bvh"))
+
+
+def metrics(bindir, folder, generated, skeleton):
+    cmd = [f"{bindir}/mo-metrics", "generation", "--gt", folder, "--gen", generated]
+    if generated.endswith(".npy"):
+        cmd += ["--skeleton", skeleton]
+    report = json.loads(run(cmd))["report"]
+    return {k: report[k]["mean"] for k, _ in METRICS}
+
+
+def sample(bindir, model, skeleton, out, n, frames, steps, sampler, seed):
+    cmd = [f"{bindir}/mo-sample", skeleton, "-n", str(n), "--frames", str(frames), "--seed", str(seed), "-q",
+           "--steps", str(steps), "--sampler", sampler]
+    if model != "builtin":
+        cmd += ["--model", model]
+    t = time.monotonic()
+    with open(out, "wb") as f:
+        run(cmd, stdout=f)
+    return time.monotonic() - t
+
+
+def row(cells):
+    return "| " + " | ".join(cells) + " |"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default="target/release")
+    ap.add_argument("--model", action="append", default=[], metavar="NAME=DIR", help="'builtin' as DIR = the embedded model")
+    ap.add_argument("--skeletons", nargs="+", required=True, metavar="FOLDER")
+    ap.add_argument("-n", type=int, default=8)
+    ap.add_argument("--frames", type=int, default=120)
+    ap.add_argument("--steps", type=int, default=10)
+    ap.add_argument("--sampler", default="ddim")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--steps-table", metavar="FOLDER", help="also: quality and time against sampling steps here")
+    args = ap.parse_args()
+    models = [m.split("=", 1) for m in args.model]
+    tmp = tempfile.mkdtemp(prefix="menagerie-eval-")
+    print(row(["skeleton", "generator"] + [h for _, h in METRICS]))
+    print(row(["---"] * (2 + len(METRICS))))
+    for folder in args.skeletons:
+        name = os.path.basename(folder.rstrip("/"))
+        skeleton = clips(folder)[0]
+        m = metrics(args.bin, folder, folder, skeleton)
+        print(row([name, "gt (the clips)"] + [f"{m[k]:.3f}" for k, _ in METRICS]), flush=True)
+        for label, model in models:
+            out = os.path.join(tmp, f"{name}_{label}.npy")
+            sample(args.bin, model, skeleton, out, args.n, args.frames, args.steps, args.sampler, args.seed)
+            m = metrics(args.bin, folder, out, skeleton)
+            print(row([name, label] + [f"{m[k]:.3f}" for k, _ in METRICS]), flush=True)
+    if args.steps_table and models:
+        label, model = models[0]
+        folder = args.steps_table
+        name = os.path.basename(folder.rstrip("/"))
+        skeleton = clips(folder)[0]
+        print()
+        print(f"{label} on {name}, {args.n} x {args.frames} frames, one thread each run:")
+        print()
+        print(row(["sampler", "steps", "wall s"] + [h for _, h in METRICS]))
+        print(row(["---"] * (3 + len(METRICS))))
+        for sampler, steps in [("ddim", 5), ("ddim", 10), ("ddim", 20), ("ddim", 50), ("ddpm", 20), ("ddpm", 100)]:
+            out = os.path.join(tmp, f"steps_{sampler}_{steps}.npy")
+            secs = sample(args.bin, model, skeleton, out, args.n, args.frames, steps, sampler, args.seed)
+            m = metrics(args.bin, folder, out, skeleton)
+            print(row([sampler, str(steps), f"{secs:.1f}"] + [f"{m[k]:.3f}" for k, _ in METRICS]), flush=True)
+
+
+if __name__ == "__main__":
+    main()
