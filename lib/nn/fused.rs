@@ -200,13 +200,10 @@ impl Attention {
                 row.fill(0.0);
                 continue;
             }
-            let mut sum = 0.0;
-            for v in row[lo..hi].iter_mut() {
-                *v = (*v - max).exp();
-                sum += *v;
-            }
+            row[lo..hi].iter_mut().for_each(|v| *v = exp(*v - max));
+            let mut sum = sum(&row[lo..hi]);
             if lo > 0 {
-                row[0] = (row[0] - max).exp();
+                row[0] = exp(row[0] - max);
                 sum += row[0];
             }
             let inv = 1.0 / sum;
@@ -374,6 +371,40 @@ impl Attention {
         }
         (dqkv, dc)
     }
+}
+
+/// `e^x` for `x <= 0` (softmax arguments after subtracting the row maximum), written so the
+/// compiler vectorises a loop of it: libm's `expf` is a call per element, and was a tenth of
+/// the attention time. Range reduction x = n ln2 + r (|r| <= ln2/2, ln2 split in two parts
+/// for precision), a degree-6 Taylor polynomial for e^r (relative error < 2e-7 there), and
+/// 2^n built in the exponent bits. Below -87 (including -inf, masked keys) the result is
+/// exactly 0, as a masked key must contribute nothing.
+#[inline(always)]
+fn exp(x: f32) -> f32 {
+    let xc = x.max(-87.0);
+    let n = (xc * std::f32::consts::LOG2_E).round();
+    let r = xc - n * 0.693_145_75 - n * 1.428_606_8e-6;
+    let p = 1.0 + r * (1.0 + r * (0.5 + r * (1.0 / 6.0 + r * (1.0 / 24.0 + r * (1.0 / 120.0 + r * (1.0 / 720.0))))));
+    let scale = f32::from_bits(((n as i32 + 127) as u32) << 23);
+    if x < -87.0 {
+        0.0
+    } else {
+        p * scale
+    }
+}
+
+/// Sum with eight independent partial sums (vectorisable, see `dot`).
+#[inline(always)]
+fn sum(a: &[f32]) -> f32 {
+    let mut acc = [0f32; 8];
+    let chunks = a.chunks_exact(8);
+    let tail: f32 = chunks.remainder().iter().sum();
+    for x in chunks {
+        for l in 0..8 {
+            acc[l] += x[l];
+        }
+    }
+    acc.iter().sum::<f32>() + tail
 }
 
 /// `a · b` with eight independent partial sums, which the compiler keeps in one vector

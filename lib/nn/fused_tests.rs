@@ -171,3 +171,18 @@ fn broadcast_add_matches_basic_ops() {
     }
     assert!(add_broadcast(x.as_tensor(), v.as_tensor(), 3).is_err(), "40 values do not split into 3 groups");
 }
+
+#[test]
+fn fast_exp_is_accurate_and_exactly_zero_for_masked_keys() {
+    let mut worst = 0f32;
+    let mut x = -87.0f32;
+    while x <= 0.0 {
+        let (a, b) = (super::exp(x), x.exp());
+        worst = worst.max(((a - b) / b).abs());
+        x += 0.0137;
+    }
+    assert!(worst < 1e-6, "relative error {worst}");
+    assert_eq!(super::exp(0.0), 1.0);
+    assert_eq!(super::exp(f32::NEG_INFINITY), 0.0);
+    assert_eq!(super::exp(-1e9), 0.0);
+}
