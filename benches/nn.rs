@@ -9,12 +9,11 @@
 //!
 //! Set `NN_BENCH_PRESETS=tiny,small` to skip presets; medians of `RUNS` runs (fewer for slow ones).
 //!
-//! Measured here (2 shared cores): the time goes to element-wise passes over the J x J and
-//! T x T attention maps and to fresh allocations (page faults, memset), not to matmuls.
-//! glibc's allocator returning large blocks to the OS costs a lot: with
-//! `MALLOC_MMAP_THRESHOLD_=4294967295 MALLOC_TRIM_THRESHOLD_=4294967295 MALLOC_TOP_PAD_=268435456`
-//! the tiny forward on `8 x 25..60` went from ~0.8-1.2 s to ~0.42 s and the step from ~2.0 s to
-//! ~1.66 s (a training binary can set the same with `mallopt`).
+//! Measured here (2 shared cores), before the fused kernels (`lib/nn/fused.rs`): the time went
+//! to element-wise passes over the J x J and T x T attention maps and to fresh allocations
+//! (page faults, memset). glibc returning large blocks to the OS cost a lot; `mo-train` and
+//! `mo-sample` call `nn::keep_freed_memory` (mallopt), this bench does not. Current numbers:
+//! BENCHMARKS.md.
 
 mod common;
 use common::{median, ms, time_runs};
