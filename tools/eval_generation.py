@@ -27,6 +27,13 @@ METRICS = [
     ("inter_diversity", "inter div"),
     ("intra_diversity_diff", "intra-div diff"),
 ]
+# mo-metrics physics, normalised by skeleton size (means over files).
+PHYSICS = [
+    ("foot_skating", "skate /s"),
+    ("jitter", "jerk /s^3"),
+    ("ground_penetration", "penetration"),
+    ("floating", "floating"),
+]
 
 
 def run(cmd, stdout=None):
@@ -45,17 +52,30 @@ def metrics(bindir, folder, generated, skeleton):
     if generated.endswith(".npy"):
         cmd += ["--skeleton", skeleton]
     report = json.loads(run(cmd))["report"]
-    return {k: report[k]["mean"] for k, _ in METRICS}
+    out = {k: report[k]["mean"] for k, _ in METRICS}
+    files = clips(generated) if os.path.isdir(generated) else []
+    if files:
+        phys = json.loads(run([f"{bindir}/mo-metrics", "physics"] + files))["files"]
+        for k, _ in PHYSICS:
+            values = [f[k]["normalised"] for f in phys if "normalised" in f[k]]  # fish have no feet
+            if values:
+                out[k] = sum(values) / len(values)
+    return out
+
+
+def cells(m):
+    return [f"{m[k]:.3f}" for k, _ in METRICS] + [f"{m[k]:.3f}" if k in m else "-" for k, _ in PHYSICS]
 
 
 def sample(bindir, model, skeleton, out, n, frames, steps, sampler, seed):
+    """Samples as BVH files in the new folder `out` (physics needs BVH); returns wall seconds."""
+    os.makedirs(out)
     cmd = [f"{bindir}/mo-sample", skeleton, "-n", str(n), "--frames", str(frames), "--seed", str(seed), "-q",
-           "--steps", str(steps), "--sampler", sampler]
+           "--steps", str(steps), "--sampler", sampler, "--bvh", os.path.join(out, "sample_{i}.bvh")]
     if model != "builtin":
         cmd += ["--model", model]
     t = time.monotonic()
-    with open(out, "wb") as f:
-        run(cmd, stdout=f)
+    run(cmd)
     return time.monotonic() - t
 
 
@@ -77,18 +97,18 @@ def main():
     args = ap.parse_args()
     models = [m.split("=", 1) for m in args.model]
     tmp = tempfile.mkdtemp(prefix="menagerie-eval-")
-    print(row(["skeleton", "generator"] + [h for _, h in METRICS]))
-    print(row(["---"] * (2 + len(METRICS))))
+    print(row(["skeleton", "generator"] + [h for _, h in METRICS + PHYSICS]))
+    print(row(["---"] * (2 + len(METRICS) + len(PHYSICS))))
     for folder in args.skeletons:
         name = os.path.basename(folder.rstrip("/"))
         skeleton = clips(folder)[0]
-        m = metrics(args.bin, folder, folder, skeleton)
-        print(row([name, "gt (the clips)"] + [f"{m[k]:.3f}" for k, _ in METRICS]), flush=True)
+        m = metrics(args.bin, folder, folder, skeleton)  # the clips against themselves
+        print(row([name, "gt (the clips)"] + cells(m)), flush=True)
         for label, model in models:
-            out = os.path.join(tmp, f"{name}_{label}.npy")
+            out = os.path.join(tmp, f"{name}_{label}")
             sample(args.bin, model, skeleton, out, args.n, args.frames, args.steps, args.sampler, args.seed)
             m = metrics(args.bin, folder, out, skeleton)
-            print(row([name, label] + [f"{m[k]:.3f}" for k, _ in METRICS]), flush=True)
+            print(row([name, label] + cells(m)), flush=True)
     if args.steps_table and models:
         label, model = models[0]
         folder = args.steps_table
@@ -97,13 +117,13 @@ def main():
         print()
         print(f"{label} on {name}, {args.n} x {args.frames} frames, one thread each run:")
         print()
-        print(row(["sampler", "steps", "wall s"] + [h for _, h in METRICS]))
-        print(row(["---"] * (3 + len(METRICS))))
+        print(row(["sampler", "steps", "wall s"] + [h for _, h in METRICS + PHYSICS]))
+        print(row(["---"] * (3 + len(METRICS) + len(PHYSICS))))
         for sampler, steps in [("ddim", 5), ("ddim", 10), ("ddim", 20), ("ddim", 50), ("ddpm", 20), ("ddpm", 100)]:
-            out = os.path.join(tmp, f"steps_{sampler}_{steps}.npy")
+            out = os.path.join(tmp, f"steps_{sampler}_{steps}")
             secs = sample(args.bin, model, skeleton, out, args.n, args.frames, steps, sampler, args.seed)
             m = metrics(args.bin, folder, out, skeleton)
-            print(row([sampler, str(steps), f"{secs:.1f}"] + [f"{m[k]:.3f}" for k, _ in METRICS]), flush=True)
+            print(row([sampler, str(steps), f"{secs:.1f}"] + cells(m)), flush=True)
 
 
 if __name__ == "__main__":
