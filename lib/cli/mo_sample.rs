@@ -132,8 +132,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let skeleton = &arg.skeleton;
     let device = Device::Cpu;
     let loaded = match &args.model {
-        Some(dir) => checkpoint::load(dir, &device)?,
-        None => checkpoint::load_default(&device)?,
+        Some(dir) => checkpoint::frozen(dir, &device)?,
+        None => checkpoint::frozen_default(&device)?,
     };
     let section = arg.record()?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };

@@ -135,12 +135,43 @@ pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::
     Ok(Loaded { info, varmap, model })
 }
 
+/// A model for sampling only: its parameters are plain tensors, not training variables.
+///
+/// Why: candle records every op whose inputs include a variable, so a forward pass through a
+/// trainable model keeps all its activations alive for a backward pass that sampling never
+/// runs: 240 MB per 120-frame sample of a 38-joint creature, growing with every layer.
+pub struct Frozen {
+    pub info: CheckpointInfo,
+    pub model: Denoiser,
+}
+
+/// `Frozen` from the bytes of `checkpoint.json` and `model.safetensors`.
+pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Frozen> {
+    let info: CheckpointInfo = serde_json::from_slice(info_json).context("checkpoint.json: not a checkpoint description")?;
+    if info.format != FORMAT || info.version != VERSION {
+        bail!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version);
+    }
+    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
+    let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
+    let model = Denoiser::new(vb, &info.config).context("model.safetensors does not match checkpoint.json's config")?;
+    Ok(Frozen { info, model })
+}
+
+/// `Frozen` from a model directory written by mo-train.
+pub fn frozen(dir: &Path, device: &Device) -> anyhow::Result<Frozen> {
+    let path = dir.join("checkpoint.json");
+    let text = std::fs::read(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
+    let weights = dir.join("model.safetensors");
+    let bytes = std::fs::read(&weights).with_context(|| format!("cannot read {}", weights.display()))?;
+    frozen_bytes(&text, &bytes, device).with_context(|| format!("model {}", dir.display()))
+}
+
 /// The default model that ships inside the binaries: a `small` denoiser trained on the
 /// synthetic zoo (models/zoo-small, see its MODEL_CARD.md).
-pub fn load_default(device: &Device) -> anyhow::Result<Loaded> {
+pub fn frozen_default(device: &Device) -> anyhow::Result<Frozen> {
     const INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
     const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");
-    load_bytes(INFO, WEIGHTS, device).context("the built-in default model")
+    frozen_bytes(INFO, WEIGHTS, device).context("the built-in default model")
 }
 
 /// The optimiser state saved beside a checkpoint.
