@@ -5,13 +5,8 @@
 //! parameters without gradients. Everything here is matmuls, broadcasts, `exp`, sums and means,
 //! which candle's autograd differentiates; `nn::anytop`'s gradient test checks every parameter.
 
-use candle_core::{DType, Device, Result, Tensor, D};
+use candle_core::{DType, Result, Tensor, D};
 use candle_nn::{Init, VarBuilder};
-
-/// Additive value for disallowed attention entries. `exp(-1e9 - max)` underflows to exactly 0
-/// in f32, so masked keys contribute nothing (not merely little) as long as a row keeps one
-/// allowed key, which every row of ours does (the rest-pose token, or the joint itself).
-pub const MASKED: f64 = -1e9;
 
 /// `y = x W^T + b` over the last dimension, for inputs of any rank (flattened to one GEMM).
 #[derive(Clone, Debug)]
@@ -124,38 +119,10 @@ pub fn sinusoid(positions: &Tensor, width: usize) -> Result<Tensor> {
     Tensor::cat(&parts, D::Minus1)
 }
 
-/// `[rows, L, width]` -> `[rows, heads, L, width/heads]` (contiguous, ready for matmul).
-pub fn split_heads(x: &Tensor, heads: usize) -> Result<Tensor> {
-    let (rows, len, width) = x.dims3()?;
-    x.reshape((rows, len, heads, width / heads))?.transpose(1, 2)?.contiguous()
-}
-
-/// Inverse of [`split_heads`].
-pub fn merge_heads(x: &Tensor) -> Result<Tensor> {
-    let (rows, heads, len, dh) = x.dims4()?;
-    x.transpose(1, 2)?.contiguous()?.reshape((rows, len, heads * dh))
-}
-
-/// A 0/1 f32 tensor `[len, len]`: 1 where query i may attend key k in the windowed temporal
-/// attention: |i - k| <= window/2, or k == 0 (every token sees the rest-pose token, §2.5).
-/// The reference's window is [i-15, i+16], one wider on the right; we keep it symmetric.
-pub fn window_mask(len: usize, window: usize, device: &Device) -> Result<Tensor> {
-    let half = window / 2;
-    let mut m = vec![0f32; len * len];
-    for i in 0..len {
-        for k in 0..len {
-            if k == 0 || i.abs_diff(k) <= half {
-                m[i * len + k] = 1.0;
-            }
-        }
-    }
-    Tensor::from_vec(m, (len, len), device)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use candle_core::Var;
+    use candle_core::{Device, Var};
 
     #[test]
     fn softmax_matches_closed_form_and_has_gradient() {
@@ -195,17 +162,6 @@ mod tests {
             assert!(gv.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap() > 1e-8);
         }
         assert!(g.get(x.as_tensor()).is_some());
-    }
-
-    #[test]
-    fn window_mask_is_symmetric_band_plus_rest_token() {
-        let m = window_mask(40, 31, &Device::Cpu).unwrap().to_vec2::<f32>().unwrap();
-        assert_eq!(m[20][5], 1.0);
-        assert_eq!(m[20][35], 1.0);
-        assert_eq!(m[20][4], 0.0);
-        assert_eq!(m[20][36], 0.0);
-        assert_eq!(m[39][0], 1.0, "the rest-pose token is always visible");
-        assert_eq!(m[39][8], 0.0);
     }
 
     #[test]

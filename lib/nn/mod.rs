@@ -1,7 +1,8 @@
 //! Neural networks on candle (CPU): AnyTop's denoiser and what it is built from.
 //!
 //! * [`config`]: `DenoiserConfig` with the `paper`, `small` and `tiny` presets;
-//! * [`layers`]: linear, layer norm, softmax and attention from basic differentiable ops
+//! * [`layers`]: linear, layer norm, feed-forward and embeddings; [`fused`]: attention and layer
+//!   norm kernels with their own backward
 //!   (candle-nn's fused CPU kernels pass no gradients);
 //! * [`init`]: a `VarBuilder` that initialises new parameters from our seeded SplitMix64
 //!   (candle's CPU RNG cannot be seeded), so the same seed gives the same model bytes;
