@@ -104,20 +104,32 @@ pub struct Loaded {
 
 /// Load `dir`'s info and model (the optimiser separately, with `load_optimizer`).
 pub fn load(dir: &Path, device: &Device) -> anyhow::Result<Loaded> {
+    let (info, weights) = read_dir_files(dir)?;
+    load_bytes(&info, &weights, device).with_context(|| format!("model {}", dir.display()))
+}
+
+/// The bytes of `dir`'s `checkpoint.json` and `model.safetensors`.
+fn read_dir_files(dir: &Path) -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
     let path = dir.join("checkpoint.json");
-    let text = std::fs::read(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
+    let info = std::fs::read(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
     let weights = dir.join("model.safetensors");
     let bytes = std::fs::read(&weights).with_context(|| format!("cannot read {}", weights.display()))?;
-    load_bytes(&text, &bytes, device).with_context(|| format!("model {}", dir.display()))
+    Ok((info, bytes))
+}
+
+/// `checkpoint.json`'s description, checked to be ours and of this version.
+fn parse_info(info_json: &[u8]) -> anyhow::Result<CheckpointInfo> {
+    let info: CheckpointInfo = serde_json::from_slice(info_json).context("checkpoint.json: not a checkpoint description")?;
+    if info.format != FORMAT || info.version != VERSION {
+        bail!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version);
+    }
+    Ok(info)
 }
 
 /// A checkpoint from the bytes of its `checkpoint.json` and `model.safetensors` (the embedded
 /// default model has no directory).
 pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Loaded> {
-    let info: CheckpointInfo = serde_json::from_slice(info_json).context("checkpoint.json: not a checkpoint description")?;
-    if info.format != FORMAT || info.version != VERSION {
-        bail!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version);
-    }
+    let info = parse_info(info_json)?;
     let varmap = VarMap::new();
     // Build every parameter (the seed does not matter: all are overwritten), then fill them.
     let model = Denoiser::new(seeded_var_builder(&varmap, 0, device), &info.config)?;
@@ -147,10 +159,7 @@ pub struct Frozen {
 
 /// `Frozen` from the bytes of `checkpoint.json` and `model.safetensors`.
 pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Frozen> {
-    let info: CheckpointInfo = serde_json::from_slice(info_json).context("checkpoint.json: not a checkpoint description")?;
-    if info.format != FORMAT || info.version != VERSION {
-        bail!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version);
-    }
+    let info = parse_info(info_json)?;
     let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
     let model = Denoiser::new(vb, &info.config).context("model.safetensors does not match checkpoint.json's config")?;
@@ -159,11 +168,8 @@ pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow
 
 /// `Frozen` from a model directory written by mo-train.
 pub fn frozen(dir: &Path, device: &Device) -> anyhow::Result<Frozen> {
-    let path = dir.join("checkpoint.json");
-    let text = std::fs::read(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
-    let weights = dir.join("model.safetensors");
-    let bytes = std::fs::read(&weights).with_context(|| format!("cannot read {}", weights.display()))?;
-    frozen_bytes(&text, &bytes, device).with_context(|| format!("model {}", dir.display()))
+    let (info, weights) = read_dir_files(dir)?;
+    frozen_bytes(&info, &weights, device).with_context(|| format!("model {}", dir.display()))
 }
 
 /// The default model that ships inside the binaries: a `small` denoiser trained on the
