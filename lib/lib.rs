@@ -8,6 +8,7 @@ pub mod binding;
 pub mod bvh;
 pub mod cli;
 pub mod diffusion;
+pub mod dift;
 pub mod document;
 pub mod embed;
 pub mod io;

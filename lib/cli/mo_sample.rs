@@ -3,14 +3,13 @@
 use crate::cli::load::{is_dash, read_skeleton};
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
+use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit::{self, KeepMask};
-use crate::diffusion::sample::{sample, Condition, SampleOptions};
+use crate::diffusion::sample::{sample, SampleOptions};
 use crate::diffusion::{Sampler, Schedule};
-use crate::embed::NameTable;
 use crate::io::{self, npy};
-use crate::repr::anytop::{AnyTopStats, IkOptions, FEATURE_DIMS};
+use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
 use crate::repr::Features;
-use crate::skeleton::topology;
 use crate::bvh;
 use anyhow::{bail, Context};
 use candle_core::Device;
@@ -160,24 +159,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => None,
     };
 
-    let stats = match checkpoint::find_trained(&loaded.info.skeletons, skeleton) {
-        Some(t) => t.stats.clone(),
-        None => match &section.stats {
-            Some(s) => s.clone(),
-            None => {
-                if !args.common.quiet {
-                    eprintln!("mo-sample: {}: not a trained skeleton and no statistics in it: normalising by its rest pose and the trained skeletons' spreads", arg.name);
-                }
-                fallback_stats(&section.rest_row, &loaded.info.skeletons.iter().map(|t| &t.stats).collect::<Vec<_>>())?
-            }
-        },
-    };
-    let mut rest = Features { frames: 1, joints: skeleton.len(), dims: FEATURE_DIMS, data: section.rest_row.concat() };
-    stats.normalise(&mut rest).map_err(|e| anyhow::anyhow!("{}: {e}", arg.name))?;
-    let names = NameTable::builtin().context("the built-in joint-name table")?.embed_skeleton(skeleton);
-    let relations = topology::relations(skeleton);
-    let distances = topology::distances(skeleton, loaded.info.dmax);
-    let cond = Condition { rest_row: &rest.data, relations: &relations, distances: &distances, names: &names, stats: &stats };
+    let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, section.stats.as_ref()).with_context(|| arg.name.clone())?;
+    if condition.stats_source == StatsSource::Fallback && !args.common.quiet {
+        eprintln!("mo-sample: {}: not a trained skeleton and no statistics in it: normalising by its rest pose and the trained skeletons' spreads", arg.name);
+    }
+    let cond = condition.condition();
     let sampler = match args.sampler {
         SamplerArg::Ddpm => Sampler::Ddpm,
         SamplerArg::Ddim => Sampler::Ddim,
@@ -304,26 +290,4 @@ fn seam_report(
         "samples": rows,
     });
     Ok(report.to_string())
-}
-
-/// Statistics for a skeleton nobody measured: its rest-pose row as the mean, and the average
-/// of the trained skeletons' (grouped) spreads — the root's from their roots, every other
-/// joint's from their non-root joints.
-fn fallback_stats(rest_row: &[Vec<f32>], trained: &[&AnyTopStats]) -> anyhow::Result<AnyTopStats> {
-    if trained.is_empty() {
-        bail!("the model records no trained skeleton statistics");
-    }
-    let d = FEATURE_DIMS;
-    let mut root = vec![0f32; d];
-    let mut joint = vec![0f32; d];
-    for s in trained {
-        for k in 0..d {
-            root[k] += s.std[k] / trained.len() as f32;
-            // Joint 1's spreads stand for every non-root joint (they share them, §1.8).
-            joint[k] += s.std.get(d + k).copied().unwrap_or(s.std[k]) / trained.len() as f32;
-        }
-    }
-    let mean: Vec<f32> = rest_row.concat();
-    let std: Vec<f32> = (0..rest_row.len()).flat_map(|j| if j == 0 { root.clone() } else { joint.clone() }).collect();
-    Ok(AnyTopStats { mean, std })
 }

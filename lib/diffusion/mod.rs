@@ -2,6 +2,7 @@
 //! The model itself is in `nn`; training and sampling loops build on both.
 
 pub mod checkpoint;
+pub mod condition;
 pub mod data;
 pub mod edit;
 pub mod sample;

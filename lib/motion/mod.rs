@@ -95,6 +95,31 @@ impl Motion {
         }
     }
 
+    /// Frames at fractional source positions `at` (frame units, clamped to the motion):
+    /// rotations slerped, translations interpolated linearly; same frame time. Resampling and
+    /// time warps are this with different positions.
+    pub fn interpolate(&self, at: &[f64]) -> Motion {
+        let j = self.joints;
+        let mut out = Motion { frames: at.len(), joints: j, frame_time: self.frame_time, rotations: Vec::with_capacity(at.len() * j), translations: Vec::with_capacity(at.len() * j) };
+        if self.frames == 0 {
+            out.frames = 0;
+            return out;
+        }
+        let last = self.frames - 1;
+        for &x in at {
+            let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, last as f64) };
+            let a = (x.floor() as usize).min(last);
+            let b = (a + 1).min(last);
+            let w = x - a as f64;
+            for k in 0..j {
+                let (ra, rb) = (self.rotations[a * j + k], self.rotations[b * j + k]);
+                out.rotations.push(if w == 0.0 { ra } else { ra.slerp(rb, w).normalize() });
+                out.translations.push(self.translations[a * j + k].lerp(self.translations[b * j + k], w));
+            }
+        }
+        out
+    }
+
     /// The skeleton's rest pose as a one-frame motion (identity rotations, OFFSET translations).
     pub fn rest(skeleton: &Skeleton) -> Motion {
         Motion {

@@ -236,6 +236,30 @@ impl Denoiser {
         if let Some(&l) = keep_layers.iter().find(|&&l| l >= self.cfg.layers) {
             return Err(NnError::Layer { requested: l, layers: self.cfg.layers });
         }
+        let mut kept = vec![None; keep_layers.len()];
+        let (h, x, token_mask) = self.run_layers(batch, self.cfg.layers, |l, h| {
+            for (slot, _) in keep_layers.iter().enumerate().filter(|(_, &k)| k == l) {
+                kept[slot] = Some(h.clone());
+            }
+        })?;
+        let t = x.dim(1)?;
+        let y = self.out.forward(&h.narrow(1, 1, t - 1)?)?;
+        let y = Tensor::cat(&[x.narrow(1, 0, 1)?, y], 1)?.broadcast_mul(&token_mask)?;
+        Ok((y, kept.into_iter().flatten().collect()))
+    }
+
+    /// The activations after layer `layer` alone, `[B, T, J, width]` with the P_S token, without
+    /// running the later layers or the output head: DIFT features at a fraction of a forward.
+    pub fn activations(&self, batch: &Batch, layer: usize) -> Result<Tensor, NnError> {
+        if layer >= self.cfg.layers {
+            return Err(NnError::Layer { requested: layer, layers: self.cfg.layers });
+        }
+        Ok(self.run_layers(batch, layer + 1, |_, _| {})?.0)
+    }
+
+    /// Enrichment and the first `layers` layers (calling `visit(l, h)` after each): the hidden
+    /// state, the zero-padded input and the token mask `[B, T, J, 1]`.
+    fn run_layers(&self, batch: &Batch, layers: usize, mut visit: impl FnMut(usize, &Tensor)) -> Result<(Tensor, Tensor, Tensor), NnError> {
         let (b, t, j) = self.check(batch)?;
         let ctx = self.context(batch, b, t, j)?;
         let token_mask = batch.frame_mask.reshape((b, t, 1, 1))?.broadcast_mul(&batch.joint_mask.reshape((b, 1, j, 1))?)?;
@@ -251,16 +275,11 @@ impl Denoiser {
             .broadcast_add(&sinusoid(&batch.positions, self.cfg.width)?.unsqueeze(2)?)?;
         let temb = sinusoid(&batch.timesteps.to_dtype(DType::F32)?, self.cfg.width)?.reshape((b, 1, 1, self.cfg.width))?;
         let bias_projection = self.bias_projection()?;
-        let mut kept = vec![None; keep_layers.len()];
-        for (l, layer) in self.layers.iter().enumerate() {
+        for (l, layer) in self.layers.iter().take(layers).enumerate() {
             h = layer.forward(&h, &temb, &ctx, &bias_projection)?;
-            for (slot, _) in keep_layers.iter().enumerate().filter(|(_, &k)| k == l) {
-                kept[slot] = Some(h.clone());
-            }
+            visit(l, &h);
         }
-        let y = self.out.forward(&h.narrow(1, 1, t - 1)?)?;
-        let y = Tensor::cat(&[x.narrow(1, 0, 1)?, y], 1)?.broadcast_mul(&token_mask)?;
-        Ok((y, kept.into_iter().flatten().collect()))
+        Ok((h, x, token_mask))
     }
 
     /// Shapes of every batch tensor against `x`'s `(B, T, J)`.

@@ -162,23 +162,10 @@ pub fn resample(motion: &Motion, fps: f64) -> Motion {
     if motion.frames.saturating_sub(1) as f64 * motion.frame_time * fps >= RESAMPLE_MAX_FRAMES as f64 {
         return motion.clone();
     }
-    let j = motion.joints;
     let duration = motion.frames.saturating_sub(1) as f64 * motion.frame_time;
     let frames = if motion.frames == 0 { 0 } else { (duration * fps).round() as usize + 1 };
-    let mut out = Motion { frames, joints: j, frame_time: 1.0 / fps, rotations: Vec::with_capacity(frames * j), translations: Vec::with_capacity(frames * j) };
-    let last = motion.frames.saturating_sub(1);
-    for t in 0..frames {
-        let x = (t as f64 / fps / motion.frame_time).clamp(0.0, last as f64);
-        let a = (x.floor() as usize).min(last);
-        let b = (a + 1).min(last);
-        let w = x - a as f64;
-        for k in 0..j {
-            let (ra, rb) = (motion.rotations[a * j + k], motion.rotations[b * j + k]);
-            out.rotations.push(if w == 0.0 { ra } else { ra.slerp(rb, w).normalize() });
-            out.translations.push(motion.translations[a * j + k].lerp(motion.translations[b * j + k], w));
-        }
-    }
-    out
+    let at: Vec<f64> = (0..frames).map(|t| t as f64 / fps / motion.frame_time).collect();
+    Motion { frame_time: 1.0 / fps, ..motion.interpolate(&at) }
 }
 
 /// Everything a run needs that does not depend on the seed.

@@ -1,0 +1,115 @@
+//! Correspondence from descriptors (AnyTop §4.1): cosine similarity between every target and
+//! every reference descriptor, and the best reference for each target. Used for joints (DIFT
+//! averaged over time) and frames (DIFT averaged over joints), and by the baselines.
+
+use crate::binding::auto::{pair_count, Choice};
+use crate::skeleton::Skeleton;
+use serde::Serialize;
+
+/// The best reference item for one target item.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Match {
+    pub target: usize,
+    pub reference: usize,
+    /// Cosine similarity of the two descriptors.
+    pub score: f64,
+    /// Best score minus the second best: how clear the choice was (1 when there is one candidate).
+    pub margin: f64,
+}
+
+/// Cosine similarity `[target][reference]`. A zero descriptor has similarity 0 with everything.
+pub fn cosine_matrix(target: &[Vec<f32>], reference: &[Vec<f32>]) -> Vec<Vec<f64>> {
+    let unit = |v: &Vec<f32>| -> Vec<f64> {
+        let n = v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
+        v.iter().map(|&x| if n > 0.0 { x as f64 / n } else { 0.0 }).collect()
+    };
+    let r: Vec<Vec<f64>> = reference.iter().map(unit).collect();
+    target.iter().map(unit).map(|t| r.iter().map(|r| t.iter().zip(r).map(|(a, b)| a * b).sum()).collect()).collect()
+}
+
+/// For every target row, the best reference column (ties to the lower index). Empty rows give
+/// no match.
+pub fn best_matches(similarity: &[Vec<f64>]) -> Vec<Match> {
+    similarity
+        .iter()
+        .enumerate()
+        .filter(|(_, row)| !row.is_empty())
+        .map(|(target, row)| {
+            let mut best = 0;
+            for (i, &s) in row.iter().enumerate() {
+                if s > row[best] {
+                    best = i;
+                }
+            }
+            let second = row.iter().enumerate().filter(|&(i, _)| i != best).map(|(_, &s)| s).fold(f64::NEG_INFINITY, f64::max);
+            let margin = if second.is_finite() { row[best] - second } else { 1.0 };
+            Match { target, reference: best, score: row[best], margin }
+        })
+        .collect()
+}
+
+/// A sparse binding (reference = source, target = target) from a joint similarity matrix
+/// `[target][reference]`: only joints whose rotation moves a bone (not the root, not leaves,
+/// as `binding::auto`), only mutual best matches among them (each is the other's first
+/// choice: the confident pairs), highest similarity first, as many as Motion2Motion's binding
+/// rate asks for (`auto::pair_count`).
+pub fn binding_choices(similarity: &[Vec<f64>], reference: &Skeleton, target: &Skeleton, rate: f64, min_pairs: usize) -> Vec<Choice> {
+    let candidates = |s: &Skeleton| -> Vec<usize> {
+        let children = s.children();
+        (1..s.len()).filter(|&j| !children[j].is_empty()).collect()
+    };
+    let (rc, tc) = (candidates(reference), candidates(target));
+    let at = |t: usize, r: usize| similarity.get(t).and_then(|row| row.get(r)).copied().unwrap_or(f64::NEG_INFINITY);
+    // First choice by score, ties to the lower index, so the result depends on nothing else.
+    let first = |scores: &mut dyn Iterator<Item = (usize, f64)>| scores.fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
+        Some((_, b)) if b >= s => best,
+        _ => Some((i, s)),
+    });
+    let mut pairs: Vec<Choice> = Vec::new();
+    for &t in &tc {
+        let Some((r, s)) = first(&mut rc.iter().map(|&r| (r, at(t, r)))) else { continue };
+        let back = first(&mut tc.iter().map(|&t2| (t2, at(t2, r))));
+        if back.map(|(t2, _)| t2) == Some(t) {
+            pairs.push(Choice { source: r, target: t, score: s });
+        }
+    }
+    pairs.sort_by(|a, b| b.score.total_cmp(&a.score).then(a.target.cmp(&b.target)));
+    pairs.truncate(pair_count(rate, reference.len(), target.len(), min_pairs));
+    pairs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn best_matches_pick_the_most_similar_direction() {
+        let reference = vec![vec![1.0, 0.0], vec![0.0, 1.0], vec![-1.0, 0.0]];
+        let target = vec![vec![0.1, 2.0], vec![3.0, 0.2], vec![0.0, 0.0]];
+        let sim = cosine_matrix(&target, &reference);
+        let m = best_matches(&sim);
+        assert_eq!(m.iter().map(|m| m.reference).collect::<Vec<_>>(), vec![1, 0, 0]);
+        assert!(m[0].score > 0.99 && m[0].margin > 0.9);
+        // The zero descriptor is similar to nothing: a tie at 0, resolved to the first.
+        assert_eq!((m[2].score, m[2].margin), (0.0, 0.0));
+    }
+
+    #[test]
+    fn binding_keeps_only_mutual_best_pairs_of_moving_joints() {
+        let (s, _) = crate::synth::creature("quadruped", 0).unwrap();
+        let n = s.len();
+        // Identity similarity, except target joint 5 prefers reference 6 which prefers target 6.
+        let mut sim: Vec<Vec<f64>> = (0..n).map(|t| (0..n).map(|r| if t == r { 0.9 } else { 0.0 }).collect()).collect();
+        sim[5][6] = 0.95;
+        let pairs = binding_choices(&sim, &s, &s, 1.0, 1);
+        let children = s.children();
+        assert!(!pairs.is_empty());
+        for p in &pairs {
+            assert!(p.source != 0 && !children[p.source].is_empty());
+            assert_eq!(p.source, p.target, "only mutual best pairs: {p:?}");
+        }
+        assert!(pairs.iter().all(|p| p.target != 5), "joint 5's first choice is not mutual");
+        let few = binding_choices(&sim, &s, &s, 0.061, 2);
+        assert_eq!(few.len(), pair_count(0.061, n, n, 2));
+    }
+}

@@ -1,0 +1,185 @@
+//! Diffusion features (DIFT, AnyTop §4.1 after Tang et al. 2023): noise a clean motion to
+//! diffusion step t, run the denoiser once, and read the activations after layer l —
+//! `[frames + 1, joints, width]`, token 0 being the rest pose P_S. Joints of different creatures
+//! that do the same job, and frames that do the same action, land close together.
+//!
+//! One noise draw gives noisy descriptors (the reference uses exactly one); we average the
+//! activations over several draws, each from its own seeded stream, so the features are a
+//! property of the motion more than of one ε.
+//!
+//! `correspond` turns features into joint and frame correspondences; `eval` has the
+//! ground-truth set-ups (renamed and shuffled copies, time warps) the benchmarks score them on.
+
+pub mod correspond;
+pub mod eval;
+
+use crate::diffusion::checkpoint::CheckpointInfo;
+use crate::diffusion::condition::SkeletonCondition;
+use crate::diffusion::sample::Condition;
+use crate::diffusion::train::gaussian;
+use crate::diffusion::Schedule;
+use crate::document::AnyTopSection;
+use crate::motion::Motion;
+use crate::nn::{batch_from, BatchItem, Denoiser};
+use crate::repr::anytop::{AnyTopOptions, AnyTopStats, RestSource};
+use crate::repr::Features;
+use crate::skeleton::Skeleton;
+use crate::synth::SplitMix64;
+use anyhow::{bail, Context};
+use candle_core::Device;
+
+/// Where and how to read the features.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DiftOptions {
+    /// Diffusion step the motion is noised to (0 = least noise; the schedule has T steps).
+    pub t: usize,
+    /// Layer whose output is read (0-based).
+    pub layer: usize,
+    /// Noise draws averaged.
+    pub draws: usize,
+    pub seed: u64,
+}
+
+impl DiftOptions {
+    /// The paper's joint-correspondence setting (§4.1: t = 2, l = 0).
+    pub const SPATIAL: DiftOptions = DiftOptions { t: 2, layer: 0, draws: 4, seed: 0 };
+    /// The paper's frame-correspondence and segmentation setting (§4.1, §5: t = 3, l = 1).
+    pub const TEMPORAL: DiftOptions = DiftOptions { t: 3, layer: 1, draws: 4, seed: 0 };
+}
+
+/// Activations `[tokens, joints, width]` (tokens = frames + 1; token 0 is P_S).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiftFeatures {
+    pub tokens: usize,
+    pub joints: usize,
+    pub width: usize,
+    pub data: Vec<f32>,
+}
+
+impl DiftFeatures {
+    /// Motion frames (tokens minus the rest-pose token).
+    pub fn frames(&self) -> usize {
+        self.tokens.saturating_sub(1)
+    }
+
+    fn at(&self, token: usize, joint: usize) -> &[f32] {
+        let i = (token * self.joints + joint) * self.width;
+        &self.data[i..i + self.width]
+    }
+
+    /// One descriptor per joint: the mean over the motion frames (the P_S token is left out:
+    /// it is the same for every motion of the skeleton, and the reference's off-by-one that
+    /// counts it is not a choice worth copying).
+    pub fn per_joint(&self) -> Vec<Vec<f32>> {
+        let first = if self.tokens > 1 { 1 } else { 0 };
+        let n = (self.tokens - first).max(1) as f32;
+        (0..self.joints)
+            .map(|j| {
+                let mut v = vec![0f32; self.width];
+                for t in first..self.tokens {
+                    v.iter_mut().zip(self.at(t, j)).for_each(|(a, b)| *a += b);
+                }
+                v.iter_mut().for_each(|a| *a /= n);
+                v
+            })
+            .collect()
+    }
+
+    /// One descriptor per motion frame: the mean over joints (frame k is token k + 1).
+    pub fn per_frame(&self) -> Vec<Vec<f32>> {
+        (1..self.tokens)
+            .map(|t| {
+                let mut v = vec![0f32; self.width];
+                for j in 0..self.joints {
+                    v.iter_mut().zip(self.at(t, j)).for_each(|(a, b)| *a += b);
+                }
+                v.iter_mut().for_each(|a| *a /= self.joints as f32);
+                v
+            })
+            .collect()
+    }
+}
+
+/// A motion ready for the denoiser: its condition, and its AnyTop features normalised.
+pub struct Prepared {
+    pub condition: SkeletonCondition,
+    /// Normalised `[frames − 1, joints, 13]` (AnyTop features drop a BVH's last frame).
+    pub features: Features,
+}
+
+/// Encode `motion` (of `skeleton`, read from `file`) for the model `info` describes: the rig's
+/// rest pose is the clip's first frame (AnyTop's rule without a T-pose file, as `skel-info`),
+/// statistics are the model's for a trained skeleton, else the clip's own.
+pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file: &str) -> anyhow::Result<Prepared> {
+    if motion.frames < 2 {
+        bail!("{file}: {} frame(s); DIFT features need a motion of at least 2 frames", motion.frames);
+    }
+    let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..AnyTopOptions::default() };
+    let section = AnyTopSection::new(skeleton, &motion.first_frames(2), &options).with_context(|| format!("{file}: cannot build an AnyTop rig"))?;
+    let mut features = section.rig.encode(skeleton, motion).map_err(|e| anyhow::anyhow!("{file}: {e}"))?.features;
+    let measured = AnyTopStats::compute([&features]).map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
+    let condition = SkeletonCondition::new(info, skeleton, &section.rest_row, Some(&measured)).with_context(|| file.to_string())?;
+    condition.stats.normalise(&mut features).map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
+    Ok(Prepared { condition, features })
+}
+
+/// Tokens (frames x joints x draws) per forward pass: bounds memory on long clips.
+const TOKENS_PER_PASS: usize = 48_000;
+
+/// DIFT features of a normalised motion (`Prepared::features`): the mean over `opts.draws`
+/// noise draws of the activations after `opts.layer` at step `opts.t`. Deterministic for
+/// `opts.seed`; draw k always takes the same noise whatever the batching.
+pub fn extract(model: &Denoiser, schedule: &Schedule, cond: &Condition, motion: &Features, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
+    let cfg = model.config();
+    if opts.t >= schedule.len() {
+        bail!("diffusion step {} is past the schedule's last ({})", opts.t, schedule.len().saturating_sub(1));
+    }
+    if opts.layer >= cfg.layers {
+        bail!("layer {} does not exist: the model has layers 0..{}", opts.layer, cfg.layers.saturating_sub(1));
+    }
+    if opts.draws == 0 {
+        bail!("at least one noise draw is needed");
+    }
+    if motion.joints != cond.names.len() || motion.dims != cfg.feature_dims || motion.frames == 0 {
+        bail!(
+            "the motion is [{}, {}, {}] but the skeleton has {} joints and the model reads {} features per joint",
+            motion.frames,
+            motion.joints,
+            motion.dims,
+            cond.names.len(),
+            cfg.feature_dims
+        );
+    }
+    let (a, b) = schedule.noise_coefficients(opts.t);
+    let per = motion.data.len();
+    let per_pass = (TOKENS_PER_PASS / ((motion.frames + 1) * motion.joints).max(1)).clamp(1, opts.draws);
+    let mut rng = SplitMix64::new(opts.seed);
+    let mut sum: Vec<f64> = Vec::new();
+    let mut done = 0;
+    while done < opts.draws {
+        let n = per_pass.min(opts.draws - done);
+        let noised: Vec<Features> = (0..n)
+            .map(|_| {
+                let eps = gaussian(&mut rng, per);
+                let data = motion.data.iter().zip(&eps).map(|(&x, &e)| (a * x as f64 + b * e as f64) as f32).collect();
+                Features { data, ..motion.clone() }
+            })
+            .collect();
+        let items: Vec<BatchItem> = noised
+            .iter()
+            .map(|f| BatchItem { features: f, rest_row: cond.rest_row, relations: cond.relations, distances: cond.distances, names: cond.names, start: 0 })
+            .collect();
+        let batch = batch_from(&items, &vec![opts.t as u32; n], device)?;
+        let h: Vec<f32> = model.activations(&batch, opts.layer)?.flatten_all()?.to_vec1()?;
+        let block = h.len() / n;
+        if sum.is_empty() {
+            sum = vec![0.0; block];
+        }
+        for draw in h.chunks_exact(block) {
+            sum.iter_mut().zip(draw).for_each(|(s, &v)| *s += v as f64);
+        }
+        done += n;
+    }
+    let data = sum.iter().map(|&s| (s / opts.draws as f64) as f32).collect();
+    Ok(DiftFeatures { tokens: motion.frames + 1, joints: motion.joints, width: cfg.width, data })
+}
