@@ -8,6 +8,7 @@
 
 pub mod docs;
 pub mod load;
+pub mod mo_dift;
 pub mod mo_encode;
 pub mod mo_metrics;
 pub mod mo_render;
@@ -80,5 +81,6 @@ pub fn all_commands() -> Vec<clap::Command> {
         mo_render::Args::command(),
         mo_train::Args::command(),
         mo_sample::Args::command(),
+        mo_dift::Args::command(),
     ]
 }

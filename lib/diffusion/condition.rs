@@ -44,6 +44,12 @@ impl SkeletonCondition {
             (None, Some(s)) => (s.clone(), StatsSource::Measured),
             (None, None) => (fallback_stats(rest_row, &info.skeletons.iter().map(|t| &t.stats).collect::<Vec<_>>())?, StatsSource::Fallback),
         };
+        SkeletonCondition::with_stats(info, skeleton, rest_row, stats, stats_source)
+    }
+
+    /// The condition with the given statistics (e.g. always the caller's own, so that two
+    /// motions compared with each other are normalised alike).
+    pub fn with_stats(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], stats: AnyTopStats, stats_source: StatsSource) -> anyhow::Result<SkeletonCondition> {
         let mut rest = Features { frames: 1, joints: skeleton.len(), dims: FEATURE_DIMS, data: rest_row.concat() };
         stats.normalise(&mut rest).map_err(|e| anyhow::anyhow!("normalising the rest pose: {e}"))?;
         let names = NameTable::builtin().context("the built-in joint-name table")?.embed_skeleton(skeleton);

@@ -63,6 +63,7 @@ pub fn bin(name: &str) -> Command {
         "mo-retarget" => env!("CARGO_BIN_EXE_mo-retarget"),
         "mo-train" => env!("CARGO_BIN_EXE_mo-train"),
         "mo-sample" => env!("CARGO_BIN_EXE_mo-sample"),
+        "mo-dift" => env!("CARGO_BIN_EXE_mo-dift"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);

@@ -1,0 +1,194 @@
+//! `mo-dift`: diffusion features of a motion, and joint and frame correspondence from them.
+
+use crate::binding::auto;
+use crate::cli::load::{expand_inputs, is_dash, load_motions, LoadOptions, Loaded};
+use crate::cli::CommonOpts;
+use crate::diffusion::checkpoint::{self, Frozen};
+use crate::diffusion::Schedule;
+use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, Match};
+use crate::dift::{self, DiftFeatures, DiftOptions};
+use crate::io::{self, npy};
+use anyhow::{bail, Context};
+use candle_core::Device;
+use std::path::PathBuf;
+
+const EXAMPLES: &str = "\
+EXAMPLES:
+    mo-dift examples/data/quadruped.bvh > quadruped_dift.npy
+    mo-dift --joints examples/data/quadruped.bvh examples/data/dragon.bvh > joints.json
+    mo-dift --joints examples/data/biped.bvh examples/data/quadruped.bvh --as-binding > bind.json
+    mo-retarget examples/data/biped.bvh examples/data/quadruped.bvh --bind bind.json -o q.bvh
+    mo-dift --frames examples/data/quadruped.bvh examples/data/dragon.bvh --draws 8 > frames.json
+    mo-dift --joints examples/data/spider.bvh examples/data/crab.bvh --t 5 --layer 1 -o sc.json";
+
+/// Diffusion features (DIFT, AnyTop §4.1) of a motion, and correspondence from them.
+///
+/// The motion is noised to diffusion step --t, the denoiser runs once, and the activations
+/// after --layer are read: [frames + 1, joints, width], token 0 being the rest pose. Several
+/// noise draws (--draws) are averaged: one draw gives noisy descriptors. Joints of different
+/// creatures that do the same job, and frames that do the same action, land close together.
+///
+/// With one INPUT: the features as NPY float32 [frames + 1, joints, width] (stdout or -o).
+///
+/// --joints REF TGT: joint correspondence. Features averaged over frames, cosine similarity,
+/// the best REF joint for every TGT joint, as JSON with scores (cosine) and margins (best minus
+/// second best). --as-binding writes instead a sparse binding REF -> TGT that `mo-retarget
+/// --bind` reads: mutual best pairs of joints that move a bone (not the root, not leaves), most
+/// similar first, as many as --bind-rate asks for (Motion2Motion's rate, as --bind auto).
+///
+/// --frames REF TGT: frame correspondence. Features averaged over joints, the best REF frame
+/// for every TGT frame, as JSON.
+///
+/// Defaults: joints t 2, layer 0; frames and plain features t 3, layer 1 (the paper's settings;
+/// see BENCHMARKS.md for accuracy on our models at other settings). AnyTop features drop a BVH's
+/// last frame, so frame k of the output is BVH frame k, and the last BVH frame has none.
+/// Inputs are BVH files, or NPY AnyTop features with --skeleton. Every clip is normalised by its
+/// own statistics, so two clips compare alike whether or not the model was trained on them.
+/// The same seed, model and inputs give the same bytes.
+#[derive(clap::Parser, Debug)]
+#[command(name = "mo-dift", version, after_long_help = EXAMPLES)]
+pub struct Args {
+    /// One motion (features), or REF TGT with --joints / --frames (BVH, or NPY with --skeleton).
+    #[arg(value_name = "INPUT", required = true, num_args = 1..=2)]
+    pub inputs: Vec<PathBuf>,
+    /// Joint correspondence between REF and TGT (JSON).
+    #[arg(long, conflicts_with = "frames")]
+    pub joints: bool,
+    /// Frame correspondence between REF and TGT (JSON).
+    #[arg(long)]
+    pub frames: bool,
+    /// With --joints: write a sparse binding REF -> TGT for mo-retarget --bind.
+    #[arg(long, requires = "joints")]
+    pub as_binding: bool,
+    /// With --as-binding: binding rate 2 x pairs / (REF joints + TGT joints).
+    #[arg(long, value_name = "R", default_value_t = 0.061, requires = "as_binding")]
+    pub bind_rate: f64,
+    /// Diffusion step the motion is noised to (0..T-1) [default: joints 2, otherwise 3].
+    #[arg(long, value_name = "T")]
+    pub t: Option<usize>,
+    /// Layer whose activations are read (0-based) [default: joints 0, otherwise 1].
+    #[arg(long, value_name = "L")]
+    pub layer: Option<usize>,
+    /// Noise draws averaged.
+    #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub draws: u64,
+    /// Model directory written by mo-train [default: the built-in model].
+    #[arg(long, value_name = "DIR")]
+    pub model: Option<PathBuf>,
+    /// Skeleton (document or BVH) that NPY inputs are decoded on.
+    #[arg(long, value_name = "FILE")]
+    pub skeleton: Option<PathBuf>,
+    #[command(flatten)]
+    pub common: CommonOpts,
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    args.common.init_threads();
+    let pairwise = args.joints || args.frames;
+    let inputs = expand_inputs(&args.inputs)?;
+    match (pairwise, inputs.len()) {
+        (true, 2) | (false, 1) => {}
+        (true, n) => bail!("--joints and --frames compare two motions, REF and TGT; {n} given"),
+        (false, n) => bail!("features are written for one motion; {n} given (use --joints or --frames to compare two)"),
+    }
+    let device = Device::Cpu;
+    let model = match &args.model {
+        Some(dir) => checkpoint::frozen(dir, &device)?,
+        None => checkpoint::frozen_default(&device)?,
+    };
+    let defaults = if args.joints { DiftOptions::SPATIAL } else { DiftOptions::TEMPORAL };
+    let opts = DiftOptions { t: args.t.unwrap_or(defaults.t), layer: args.layer.unwrap_or(defaults.layer), draws: args.draws as usize, seed: args.common.seed };
+    let motions = load_motions(&inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
+    if motions.len() != inputs.len() {
+        bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
+    }
+    let features: Vec<DiftFeatures> = motions.iter().map(|m| features_of(&model, m, &opts, &device)).collect::<anyhow::Result<_>>()?;
+    let bytes = if !pairwise {
+        let f = &features[0];
+        if args.common.output.as_deref().is_none_or(is_dash) && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+            bail!("refusing to write NPY to a terminal: redirect stdout or give -o FILE");
+        }
+        let mut bytes = Vec::new();
+        npy::write_f32_parts(&mut bytes, &[f.tokens, f.joints, f.width], &[f.data.as_slice()]).context("building the NPY")?;
+        bytes
+    } else {
+        let (reference, target) = (&motions[0], &motions[1]);
+        let header = serde_json::json!({
+            "reference": reference.name, "target": target.name, "t": opts.t, "layer": opts.layer, "draws": opts.draws,
+            "model": args.model.as_ref().map_or_else(|| "built-in".to_string(), |p| p.display().to_string()),
+        });
+        let text = if args.joints {
+            let sim = cosine_matrix(&features[1].per_joint(), &features[0].per_joint());
+            if args.as_binding {
+                if !(args.bind_rate.is_finite() && args.bind_rate > 0.0 && args.bind_rate <= 1.0) {
+                    bail!("--bind-rate must be within (0, 1], found {}", args.bind_rate);
+                }
+                let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, args.bind_rate, auto::AutoOptions::default().min_pairs);
+                if choices.is_empty() {
+                    bail!("{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind", reference.name, target.name);
+                }
+                auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
+            } else {
+                let rows = best_matches(&sim).iter().map(|m| joint_row(m, reference, target)).collect::<Vec<_>>();
+                pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
+            }
+        } else {
+            let rows: Vec<_> = best_matches(&cosine_matrix(&features[1].per_frame(), &features[0].per_frame()))
+                .iter()
+                .map(|m| FrameRow { target: m.target, reference: m.reference, score: round(m.score), margin: round(m.margin) })
+                .collect();
+            pretty(serde_json::json!({ "correspondence": "frames", "settings": header, "matches": rows }))
+        };
+        text.into_bytes()
+    };
+    io::write_output(args.common.output.as_deref(), &bytes).context("cannot write the output")
+}
+
+/// DIFT features of one loaded motion.
+fn features_of(model: &Frozen, m: &Loaded, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
+    let prepared = dift::prepare(&model.info, &m.skeleton, &m.motion, &m.name)?;
+    let schedule = Schedule::cosine(model.info.schedule_steps);
+    dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, device).with_context(|| m.name.clone())
+}
+
+/// One target joint's answer (a struct, so the fields print in this order).
+#[derive(serde::Serialize)]
+struct JointRow {
+    target: String,
+    target_index: usize,
+    reference: String,
+    reference_index: usize,
+    score: f64,
+    margin: f64,
+}
+
+fn joint_row(m: &Match, reference: &Loaded, target: &Loaded) -> JointRow {
+    JointRow {
+        target: target.skeleton.joints[m.target].name.clone(),
+        target_index: m.target,
+        reference: reference.skeleton.joints[m.reference].name.clone(),
+        reference_index: m.reference,
+        score: round(m.score),
+        margin: round(m.margin),
+    }
+}
+
+/// One target frame's answer.
+#[derive(serde::Serialize)]
+struct FrameRow {
+    target: usize,
+    reference: usize,
+    score: f64,
+    margin: f64,
+}
+
+/// Four decimals: scores are cosines; more digits are noise to a reader.
+fn round(v: f64) -> f64 {
+    (v * 1e4).round() / 1e4
+}
+
+fn pretty(v: serde_json::Value) -> String {
+    let mut s = serde_json::to_string_pretty(&v).unwrap_or_else(|_| v.to_string());
+    s.push('\n');
+    s
+}
