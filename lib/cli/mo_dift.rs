@@ -17,7 +17,6 @@ EXAMPLES:
     mo-dift examples/data/quadruped.bvh > quadruped_dift.npy
     mo-dift --joints examples/data/quadruped.bvh examples/data/dragon.bvh > joints.json
     mo-dift --joints examples/data/biped.bvh examples/data/quadruped.bvh --as-binding > bind.json
-    mo-retarget examples/data/biped.bvh examples/data/quadruped.bvh --bind bind.json -o q.bvh
     mo-dift --frames examples/data/quadruped.bvh examples/data/dragon.bvh --draws 8 > frames.json
     mo-dift --joints examples/data/spider.bvh examples/data/crab.bvh --t 5 --layer 1 -o sc.json";
 
@@ -33,7 +32,7 @@ EXAMPLES:
 /// --joints REF TGT: joint correspondence. Features averaged over frames, cosine similarity,
 /// the best REF joint for every TGT joint, as JSON with scores (cosine) and margins (best minus
 /// second best). --as-binding writes instead a sparse binding REF -> TGT that `mo-retarget
-/// --bind` reads: mutual best pairs of joints that move a bone (not the root, not leaves), most
+/// --bind` reads (`mo-retarget REF.bvh TGT.bvh --bind bind.json`): mutual best pairs of joints that move a bone (not the root, not leaves), most
 /// similar first, as many as --bind-rate asks for (Motion2Motion's rate, as --bind auto).
 ///
 /// --frames REF TGT: frame correspondence. Features averaged over joints, the best REF frame

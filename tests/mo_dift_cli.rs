@@ -1,0 +1,85 @@
+//! `mo-dift` end to end with the built-in model: features have the documented shape and the
+//! same bytes for the same seed; a skeleton matched against its own `skel-aug` variant finds
+//! most surviving joints; `--as-binding` writes a binding that `mo-retarget` accepts; frame
+//! matching of a clip with itself is the identity; bad inputs exit 2 without output.
+mod common;
+
+use common::{check_failure, ok, run, s, tempdir};
+use menagerie::binding::Binding;
+use menagerie::io::npy;
+use std::path::{Path, PathBuf};
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data").join(name)
+}
+
+fn json(bytes: &[u8]) -> serde_json::Value {
+    serde_json::from_slice(bytes).expect("JSON output")
+}
+
+#[test]
+fn features_have_one_token_per_frame_plus_the_rest_pose_and_repeat_by_seed() {
+    let quad = example("quadruped.bvh");
+    let a = run("mo-dift", &[s(&quad), "--draws", "2"], None);
+    ok(&a, "features");
+    let array = npy::from_bytes(&a.stdout, "dift").unwrap();
+    let motion_frames = menagerie::bvh::read_path(&quad).unwrap().frames;
+    // AnyTop features drop the last BVH frame; the rest-pose token comes first.
+    assert_eq!(array.shape, vec![motion_frames, 26, 64]);
+    assert!(array.data.iter().all(|v| v.is_finite()));
+    assert_eq!(a.stdout, run("mo-dift", &[s(&quad), "--draws", "2"], None).stdout, "same seed, same bytes");
+    assert_ne!(a.stdout, run("mo-dift", &[s(&quad), "--draws", "2", "--seed", "1"], None).stdout, "the noise depends on the seed");
+}
+
+#[test]
+fn joints_of_a_skel_aug_variant_find_their_originals_and_bind() {
+    let dir = tempdir("joints");
+    let quad = example("quadruped.bvh");
+    let variant = dir.join("variant.bvh");
+    ok(&run("skel-aug", &[s(&quad), "--seed", "1", "--add", "2", "-o", s(&variant)], None), "skel-aug");
+    let out = run("mo-dift", &["--joints", s(&quad), s(&variant)], None);
+    ok(&out, "joints");
+    let doc = json(&out.stdout);
+    let matches = doc["matches"].as_array().unwrap();
+    let surviving: Vec<_> = matches.iter().filter(|m| !m["target"].as_str().unwrap().ends_with("_mid")).collect();
+    let right = surviving.iter().filter(|m| m["target"] == m["reference"]).count();
+    assert!(right * 10 >= surviving.len() * 8, "{right} of {} surviving joints matched their originals", surviving.len());
+
+    let binding_file = dir.join("bind.json");
+    ok(&run("mo-dift", &["--joints", s(&quad), s(&variant), "--as-binding", "-o", s(&binding_file)], None), "binding");
+    let text = std::fs::read_to_string(&binding_file).unwrap();
+    let binding = Binding::from_json(&text, "bind.json").unwrap();
+    assert!(binding.mapping.len() >= 2);
+    let retargeted = dir.join("out.bvh");
+    let args = [s(&quad), s(&variant), "--bind", s(&binding_file), "--seconds", "1", "-o", s(&retargeted), "-q"];
+    ok(&run("mo-retarget", &args, None), "mo-retarget with the DIFT binding");
+    assert!(std::fs::metadata(&retargeted).unwrap().len() > 0);
+}
+
+#[test]
+fn frames_of_a_clip_against_itself_match_one_to_one() {
+    let quad = example("quadruped.bvh");
+    let out = run("mo-dift", &["--frames", s(&quad), s(&quad), "--draws", "2"], None);
+    ok(&out, "frames");
+    let doc = json(&out.stdout);
+    let matches = doc["matches"].as_array().unwrap();
+    assert!(!matches.is_empty());
+    let exact = matches.iter().filter(|m| m["target"] == m["reference"]).count();
+    assert_eq!(exact, matches.len(), "identical clips, identical noise: every frame is its own best match");
+}
+
+#[test]
+fn bad_inputs_exit_2_without_output() {
+    let dir = tempdir("bad");
+    let quad = example("quadruped.bvh");
+    let out = dir.join("out.json");
+    let one = run("mo-dift", &["--joints", s(&quad), "-o", s(&out)], None);
+    check_failure("mo-dift", "one input", &one, "REF and TGT");
+    let broken = dir.join("broken.bvh");
+    std::fs::write(&broken, "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0\n").unwrap();
+    let bad = run("mo-dift", &["--frames", s(&quad), s(&broken), "-o", s(&out)], None);
+    check_failure("mo-dift", "broken BVH", &bad, "broken.bvh");
+    let t = run("mo-dift", &[s(&quad), "--t", "100", "-o", s(&out)], None);
+    check_failure("mo-dift", "step past T", &t, "diffusion step 100");
+    assert!(!out.exists(), "no partial output");
+}
