@@ -2,8 +2,10 @@
 //! several (t, layer) settings against a names-only and a geometry-only baseline, on each clip
 //! against (a) a copy with its joints in another file order and numbers for names and (b)
 //! `skel-aug` variants (10-30% of the joints removed, 2 added; surviving joints keep their
-//! names); left/right confusions counted apart. Then frame correspondence against a
-//! time-warped copy (mean frame error), and the time one extraction takes.
+//! names); left/right confusions counted apart, raw and centred descriptors (`dift::centred`),
+//! clips at temporal position 0. Then frame correspondence against a time-warped copy (mean
+//! frame error; each draw at a random temporal position, `DiftOptions::shift`), and the time
+//! one extraction takes.
 //!
 //!     cargo bench --bench dift                       # built-in model
 //!     MENAGERIE_DIFT_MODEL=DIR cargo bench --bench dift
@@ -71,10 +73,10 @@ fn facing_rest(s: &Skeleton, m: &Motion) -> Option<Vec<glam::DVec3>> {
     Some(section.rig.rest_positions(s))
 }
 
-/// Per setting: [raw, centred] per-joint and [raw, centred, minus still] per-frame descriptors.
+/// Per setting: [raw, centred] per-joint and per-frame descriptors.
 struct Extracted {
     per_joint: Vec<[Vec<Vec<f32>>; 2]>,
-    per_frame: Vec<[Vec<Vec<f32>>; 3]>,
+    per_frame: Vec<[Vec<Vec<f32>>; 2]>,
     raw_frames: Vec<Vec<f32>>,
     seconds: f64,
 }
@@ -86,11 +88,10 @@ fn extract_all(model: &Frozen, s: &Skeleton, m: &Motion, name: &str) -> anyhow::
     let (mut per_joint, mut per_frame) = (Vec::new(), Vec::new());
     let started = Instant::now();
     for &(t, layer) in &SETTINGS {
-        let opts = DiftOptions { t, layer, draws: DRAWS, seed: 0 };
-        let f = dift::extract(&model.model, &schedule, &cond, &prepared.features, &opts, &Device::Cpu)?;
-        let still = dift::extract(&model.model, &schedule, &cond, &dift::still_motion(&cond, prepared.features.frames), &opts, &Device::Cpu)?;
-        per_joint.push([f.per_joint(), dift::centred(f.per_joint())]);
-        per_frame.push([f.per_frame(), dift::centred(f.per_frame()), f.minus(&still)?.per_frame()]);
+        let extract = |shift| dift::extract(&model.model, &schedule, &cond, &prepared.features, &DiftOptions { t, layer, draws: DRAWS, seed: 0, shift }, &Device::Cpu);
+        let (fixed, shifted) = (extract(false)?, extract(true)?);
+        per_joint.push([fixed.per_joint(), dift::centred(fixed.per_joint())]);
+        per_frame.push([shifted.per_frame(), dift::centred(shifted.per_frame())]);
     }
     let seconds = started.elapsed().as_secs_f64() / SETTINGS.len() as f64;
     let per = prepared.features.joints * prepared.features.dims;
@@ -158,7 +159,7 @@ fn main() {
             let n = w.per_frame[0][0].len();
             let truth = &truth[..n];
             let mut errors: Vec<f64> = (0..SETTINGS.len())
-                .flat_map(|k| (0..3).map(move |v| (k, v)))
+                .flat_map(|k| (0..2).map(move |v| (k, v)))
                 .map(|(k, v)| eval::frame_error(&best_matches(&cosine_matrix(&w.per_frame[k][v], &reference.per_frame[k][v])), truth))
                 .collect();
             errors.push(eval::frame_error(&best_matches(&cosine_matrix(&w.raw_frames, &reference.raw_frames)), truth));
@@ -181,7 +182,7 @@ fn main() {
     println!("\n## Frame correspondence against a time-warped copy (warp strength 0.5): mean frame error\n");
     let frame_methods: Vec<String> = SETTINGS
         .iter()
-        .flat_map(|(t, l)| [format!("DIFT t{t} l{l}"), format!("centred t{t} l{l}"), format!("minus still t{t} l{l}")])
+        .flat_map(|(t, l)| [format!("DIFT t{t} l{l}"), format!("centred t{t} l{l}")])
         .chain(["raw features".into(), "no matching (k -> k)".into()])
         .collect();
     println!("| clips | {} |", frame_methods.join(" | "));

@@ -29,14 +29,17 @@ EXAMPLES:
 ///
 /// With one INPUT: the features as NPY float32 [frames + 1, joints, width] (stdout or -o).
 ///
-/// --joints REF TGT: joint correspondence. Features averaged over frames, cosine similarity,
+/// --joints REF TGT: joint correspondence. Features averaged over frames, each skeleton's mean
+/// joint descriptor subtracted (what all its joints share would otherwise dominate), cosine,
 /// the best REF joint for every TGT joint, as JSON with scores (cosine) and margins (best minus
 /// second best). --as-binding writes instead a sparse binding REF -> TGT that `mo-retarget
-/// --bind` reads (`mo-retarget REF.bvh TGT.bvh --bind bind.json`): mutual best pairs of joints that move a bone (not the root, not leaves), most
-/// similar first, as many as --bind-rate asks for (Motion2Motion's rate, as --bind auto).
+/// REF.bvh TGT.bvh --bind bind.json` reads: mutual best pairs of joints that move a bone (not
+/// the root, not leaves), most similar first, as many as --bind-rate asks for
+/// (Motion2Motion's rate, as --bind auto).
 ///
 /// --frames REF TGT: frame correspondence. Features averaged over joints, the best REF frame
-/// for every TGT frame, as JSON.
+/// for every TGT frame, as JSON. Each noise draw places the clip at its own random temporal
+/// position, so that frames are not matched for sharing a position embedding.
 ///
 /// Defaults: joints t 2, layer 0; frames and plain features t 3, layer 1 (the paper's settings;
 /// see BENCHMARKS.md for accuracy on our models at other settings). AnyTop features drop a BVH's
@@ -96,7 +99,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => checkpoint::frozen_default(&device)?,
     };
     let defaults = if args.joints { DiftOptions::SPATIAL } else { DiftOptions::TEMPORAL };
-    let opts = DiftOptions { t: args.t.unwrap_or(defaults.t), layer: args.layer.unwrap_or(defaults.layer), draws: args.draws as usize, seed: args.common.seed };
+    let opts = DiftOptions { t: args.t.unwrap_or(defaults.t), layer: args.layer.unwrap_or(defaults.layer), draws: args.draws as usize, seed: args.common.seed, ..defaults };
     let motions = load_motions(&inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
     if motions.len() != inputs.len() {
         bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
@@ -117,7 +120,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "model": args.model.as_ref().map_or_else(|| "built-in".to_string(), |p| p.display().to_string()),
         });
         let text = if args.joints {
-            let sim = cosine_matrix(&features[1].per_joint(), &features[0].per_joint());
+            let sim = cosine_matrix(&dift::centred(features[1].per_joint()), &dift::centred(features[0].per_joint()));
             if args.as_binding {
                 if !(args.bind_rate.is_finite() && args.bind_rate > 0.0 && args.bind_rate <= 1.0) {
                     bail!("--bind-rate must be within (0, 1], found {}", args.bind_rate);
