@@ -13,6 +13,7 @@ pub mod mo_metrics;
 pub mod mo_render;
 pub mod mo_retarget;
 pub mod mo_sample;
+pub mod mo_segment;
 pub mod mo_train;
 pub mod skel_aug;
 pub mod skel_info;
@@ -80,5 +81,6 @@ pub fn all_commands() -> Vec<clap::Command> {
         mo_render::Args::command(),
         mo_train::Args::command(),
         mo_sample::Args::command(),
+        mo_segment::Args::command(),
     ]
 }

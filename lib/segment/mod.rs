@@ -141,7 +141,8 @@ pub fn segment(frames: &[Vec<f64>], options: &SegmentOptions, seed: u64) -> Resu
 }
 
 /// Per frame, the mean and the standard deviation of every dimension over the `window` frames
-/// centred on it (cut at the clip's ends): `2 × dims` values. `window` ≤ 1 returns the input.
+/// centred on it (shifted inward at the clip's ends; the whole clip when it is shorter):
+/// `2 × dims` values. `window` ≤ 1 returns the input.
 pub fn context(frames: &[Vec<f64>], window: usize) -> Vec<Vec<f64>> {
     let n = frames.len();
     let Some(d) = frames.first().map(Vec::len) else { return Vec::new() };
@@ -149,7 +150,6 @@ pub fn context(frames: &[Vec<f64>], window: usize) -> Vec<Vec<f64>> {
         return frames.to_vec();
     }
     let before = (window - 1) / 2;
-    let after = window - 1 - before;
     // Prefix sums of x and x² make every window O(d).
     let mut sum = vec![vec![0.0; d]; n + 1];
     let mut sq = vec![vec![0.0; d]; n + 1];
@@ -161,7 +161,11 @@ pub fn context(frames: &[Vec<f64>], window: usize) -> Vec<Vec<f64>> {
     }
     (0..n)
         .map(|t| {
-            let (lo, hi) = (t.saturating_sub(before), (t + after + 1).min(n));
+            // Near the ends the window slides inward rather than shrinking, so every frame is
+            // described over the same duration (a shrunken window sees less of a gait cycle and
+            // would make the clip's ends look like a different action).
+            let lo = t.saturating_sub(before).min(n.saturating_sub(window));
+            let hi = (lo + window).min(n);
             let m = (hi - lo) as f64;
             let mean: Vec<f64> = (0..d).map(|j| (sum[hi][j] - sum[lo][j]) / m).collect();
             // Cancellation can make the variance slightly negative; it is zero then.

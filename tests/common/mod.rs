@@ -63,6 +63,7 @@ pub fn bin(name: &str) -> Command {
         "mo-retarget" => env!("CARGO_BIN_EXE_mo-retarget"),
         "mo-train" => env!("CARGO_BIN_EXE_mo-train"),
         "mo-sample" => env!("CARGO_BIN_EXE_mo-sample"),
+        "mo-segment" => env!("CARGO_BIN_EXE_mo-segment"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);
