@@ -132,8 +132,8 @@ struct Config {
     window_seconds: f64,
 }
 
-fn config(label: &str, k: usize, pca_dims: usize, window_seconds: f64, min_segment: usize, standardise: bool) -> Config {
-    let options = SegmentOptions { k, pca_dims, window: 0, min_segment, standardise, ..SegmentOptions::default() };
+fn config(label: &str, k: usize, pca_dims: usize, window_seconds: f64, min_segment: usize, standardise: bool, refine: bool) -> Config {
+    let options = SegmentOptions { k, pca_dims, window: 0, min_segment, standardise, refine, ..SegmentOptions::default() };
     Config { label: label.to_string(), options, window_seconds }
 }
 
@@ -202,16 +202,19 @@ fn main() {
     let families = [("synthetic", synthetic()), ("real", real())];
     let providers: Vec<(&str, Provider)> = vec![("raw", &raw_features)];
     let configs = vec![
-        config("single frames k3 pca8 min10", 3, 8, 0.0, 10, false),
-        config("window 0.5s k3 pca8 min10", 3, 8, 0.5, 10, false),
-        config("window 1s k3 pca8 min10", 3, 8, 1.0, 10, false),
-        config("window 2s k3 pca8 min10", 3, 8, 2.0, 10, false),
-        config("window 1s k2 pca8 min10", 2, 8, 1.0, 10, false),
-        config("window 1s k3 pca8 min10 std", 3, 8, 1.0, 10, true),
-        config("window 1s k3 pca4 min10", 3, 4, 1.0, 10, false),
-        config("window 1s k3 pca16 min10", 3, 16, 1.0, 10, false),
-        config("window 1s k3 pca8 min5", 3, 8, 1.0, 5, false),
-        config("window 1s k3 pca8 min20", 3, 8, 1.0, 20, false),
+        config("single frames k3 pca8 min10", 3, 8, 0.0, 10, false, true),
+        config("window 0.5s k3 pca8 min10", 3, 8, 0.5, 10, false, true),
+        config("window 0.5s k3 pca8 min10 norefine", 3, 8, 0.5, 10, false, false),
+        config("window 1s k3 pca8 min10 norefine", 3, 8, 1.0, 10, false, false),
+        config("window 1s k3 pca8 min10", 3, 8, 1.0, 10, false, true),
+        config("window 2s k3 pca8 min10", 3, 8, 2.0, 10, false, true),
+        config("window 1s k2 pca8 min10", 2, 8, 1.0, 10, false, true),
+        config("window 0.5s k2 pca8 min10", 2, 8, 0.5, 10, false, true),
+        config("window 1s k3 pca8 min10 std", 3, 8, 1.0, 10, true, true),
+        config("window 1s k3 pca4 min10", 3, 4, 1.0, 10, false, true),
+        config("window 1s k3 pca16 min10", 3, 16, 1.0, 10, false, true),
+        config("window 1s k3 pca8 min5", 3, 8, 1.0, 5, false, true),
+        config("window 1s k3 pca8 min20", 3, 8, 1.0, 20, false, true),
     ];
     println!("segmentation vs known boundaries (frames); seed 0; time = median per clip, features + segmentation");
     println!(

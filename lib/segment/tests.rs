@@ -18,7 +18,7 @@ fn phases(centres: &[[f64; 2]], counts: &[usize], dims: usize, seed: u64) -> Vec
 }
 
 fn options(k: usize, pca_dims: usize, window: usize, min_segment: usize) -> SegmentOptions {
-    SegmentOptions { k, pca_dims, window, min_segment, standardise: false, restarts: 4 }
+    SegmentOptions { k, pca_dims, window, min_segment, standardise: false, restarts: 4, refine: true }
 }
 
 #[test]
@@ -52,6 +52,18 @@ fn context_window_tells_a_varying_phase_from_a_still_one() {
     let b = boundaries(&windowed.labels);
     assert_eq!(b.len(), 2, "{:?}", windowed.segments);
     assert!(b[0].abs_diff(60) <= 6 && b[1].abs_diff(100) <= 6, "{b:?}");
+}
+
+#[test]
+fn refine_moves_a_boundary_to_the_change_of_activity() {
+    // Still for 50 frames, then alternating: the change is at 50; a boundary at 44 moves there.
+    let points: Vec<Vec<f64>> = (0..100).map(|t| vec![if t < 50 { 0.0 } else if t % 2 == 0 { 1.0 } else { -1.0 }]).collect();
+    let labels = [vec![0; 44], vec![1; 56]].concat();
+    assert_eq!(boundaries(&refine(&points, &labels, 8)), vec![50]);
+    // Out of sight (radius 3 looks at frames 38..50, all still): every split scores the same and
+    // the boundary stays.
+    assert_eq!(boundaries(&refine(&points, &labels, 3)), vec![44]);
+    assert_eq!(refine(&points, &labels, 0), labels);
 }
 
 #[test]
