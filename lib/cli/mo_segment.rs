@@ -54,7 +54,7 @@ pub struct Args {
     pub pca_dims: usize,
     /// Temporal context: mean and std of each component over this many seconds around a frame
     /// (0 = single frames).
-    #[arg(long, value_name = "SECONDS", default_value_t = 1.0)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 1.0, allow_negative_numbers = true)]
     pub window: f64,
     /// Shortest segment in frames; shorter runs are merged into their longer neighbour.
     #[arg(long, value_name = "FRAMES", default_value_t = 10)]
