@@ -123,11 +123,13 @@ pub fn raw_features(input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
     Ok(segment::raw_frame_features(&encoded.features))
 }
 
-/// One feature vector per frame of `input`, row t describing BVH frame t (rows may stop short
-/// of the last frames; `segment_input` gives those the last row's label). New feature kinds
-/// (DIFT) are one more arm here.
-pub fn frame_features(kind: Features, input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
-    match kind {
+/// One feature vector per frame of `input` for `--features`, row t describing BVH frame t (rows
+/// may stop short of the last frames; `segment_input` gives those the last row's label; all rows
+/// the same length, finite). New feature kinds (DIFT) are one more `Features` variant and one
+/// more arm here, reading their own flags (model, step, layer, draws, `args.common.seed`) from
+/// `args`.
+pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
+    match args.features {
         Features::Raw => raw_features(input),
     }
 }
@@ -164,7 +166,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         ..SegmentOptions::default()
     };
     let started = std::time::Instant::now();
-    let features = frame_features(args.features, &input)?;
+    let features = frame_features(args, &input)?;
     let result = segment_input(&input, &features, &options, args.common.seed)?;
     if args.common.verbose {
         eprintln!(
