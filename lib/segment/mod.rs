@@ -139,9 +139,11 @@ pub fn segment(frames: &[Vec<f64>], options: &SegmentOptions, seed: u64) -> Resu
         let p = pca(frames, options.pca_dims)?;
         (p.projections, p.dims, p.explained)
     };
-    let single = (options.window > 1 && options.refine).then(|| points.clone());
-    if options.window > 1 {
-        points = context(&points, options.window);
+    // A window longer than the clip is the whole clip.
+    let window = options.window.min(frames.len());
+    let single = (window > 1 && options.refine).then(|| points.clone());
+    if window > 1 {
+        points = context(&points, window);
     }
     if options.standardise {
         standardise(&mut points);
@@ -149,7 +151,7 @@ pub fn segment(frames: &[Vec<f64>], options: &SegmentOptions, seed: u64) -> Resu
     let clustered = kmeans(&points, options.k, seed, options.restarts)?;
     let mut labels = smooth(&clustered.labels, options.min_segment);
     if let Some(single) = single {
-        labels = smooth(&refine(&single, &labels, options.window / 2), options.min_segment);
+        labels = smooth(&refine(&single, &labels, window / 2), options.min_segment);
     }
     let clusters = labels.iter().max().map_or(0, |m| m + 1);
     Ok(Segmentation { segments: segments(&labels), labels, pca_dims, explained_variance, clusters })
@@ -180,7 +182,7 @@ pub fn context(frames: &[Vec<f64>], window: usize) -> Vec<Vec<f64>> {
             // described over the same duration (a shrunken window sees less of a gait cycle and
             // would make the clip's ends look like a different action).
             let lo = t.saturating_sub(before).min(n.saturating_sub(window));
-            let hi = (lo + window).min(n);
+            let hi = lo.saturating_add(window).min(n);
             let m = (hi - lo) as f64;
             let mean: Vec<f64> = (0..d).map(|j| (sum[hi][j] - sum[lo][j]) / m).collect();
             // Cancellation can make the variance slightly negative; it is zero then.
@@ -228,10 +230,10 @@ pub fn refine(points: &[Vec<f64>], labels: &[usize], radius: usize) -> Vec<usize
     let mut previous = 0;
     for (i, &b) in marks.iter().enumerate() {
         let next = marks.get(i + 1).copied().unwrap_or(n);
-        let lo = previous.max(b.saturating_sub(2 * radius));
-        let hi = next.min(b + 2 * radius);
+        let lo = previous.max(b.saturating_sub(radius.saturating_mul(2)));
+        let hi = next.min(b.saturating_add(radius.saturating_mul(2)));
         let first = (lo + 2).max(b.saturating_sub(radius));
-        let last = hi.saturating_sub(2).min(b + radius);
+        let last = hi.saturating_sub(2).min(b.saturating_add(radius));
         let mut best = (b, f64::INFINITY);
         for s in first..=last {
             let c = cost(lo, s, hi);

@@ -64,6 +64,8 @@ fn refine_moves_a_boundary_to_the_change_of_activity() {
     // the boundary stays.
     assert_eq!(boundaries(&refine(&points, &labels, 3)), vec![44]);
     assert_eq!(refine(&points, &labels, 0), labels);
+    assert_eq!(boundaries(&refine(&points, &labels, usize::MAX)), vec![50]);
+    assert_eq!(context(&points, usize::MAX).len(), 100);
 }
 
 #[test]
@@ -121,6 +123,8 @@ fn degenerate_inputs_are_errors_or_trivial_answers() {
     assert_eq!(one.labels, vec![0]);
     assert_eq!(one.segments, vec![Segment { start: 0, end: 1, label: 0 }]);
     assert!(matches!(segment(&vec![vec![1.0]; 2], &options(3, 2, 0, 1), 0), Err(SegmentError::TooFewFrames { k: 3, frames: 2 })));
+    let huge = SegmentOptions { window: usize::MAX, min_segment: usize::MAX, pca_dims: usize::MAX, ..SegmentOptions::default() };
+    assert_eq!(segment(&phases(&[[0.0, 0.0]], &[12], 3, 1), &huge, 0).unwrap().labels, vec![0; 12]);
     let constant = segment(&vec![vec![0.5; 4]; 20], &SegmentOptions::default(), 0).unwrap();
     assert_eq!(constant.labels, vec![0; 20]);
     assert!(constant.explained_variance.is_finite());
