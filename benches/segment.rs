@@ -53,7 +53,7 @@ fn synthetic() -> Vec<Case> {
                     [first, last] => vec![*first, last + 1],
                     _ => continue,
                 };
-                let input = Input::new(format!("{name}_v{variant}_s{seed}"), clip.skeleton, clip.motion).expect("synthetic clip");
+                let input = Input::from_motion(format!("{name}_v{variant}_s{seed}"), clip.skeleton, &clip.motion).expect("synthetic clip");
                 out.push(Case { input, truth });
             }
         }
@@ -116,7 +116,7 @@ fn real() -> Vec<Case> {
         let short = |f: &str| Path::new(f).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let name = format!("{}+{}", short(fa), short(fb));
         let truth = vec![ma.frames];
-        match Input::new(name, sa, concat(&ma, &mb)) {
+        match Input::from_motion(name, sa, &concat(&ma, &mb)) {
             Ok(input) => out.push(Case { input, truth }),
             Err(e) => println!("SKIP {fa} + {fb}: {e:#}"),
         }
@@ -150,7 +150,7 @@ fn evaluate(cases: &[Case], provider: Provider, c: &Config, seed: u64, verbose: 
     let mut s = Score { errors: Vec::new(), missed: 0, spurious: 0, clips: 0, times: Vec::new(), failures: 0 };
     for case in cases {
         let started = Instant::now();
-        let options = SegmentOptions { window: window_frames(c.window_seconds, case.input.frame_time()), ..c.options.clone() };
+        let options = SegmentOptions { window: window_frames(c.window_seconds, case.input.frame_time), ..c.options.clone() };
         let result = provider(&case.input).and_then(|f| segment_input(&case.input, &f, &options, seed));
         s.times.push(started.elapsed());
         let Ok(result) = result else {

@@ -4,7 +4,7 @@ complete -c mo-segment -l window -d 'Temporal context: mean and std of each comp
 complete -c mo-segment -l min-segment -d 'Shortest segment in frames; shorter runs are merged into their longer neighbour' -r
 complete -c mo-segment -l features -d 'What each frame is described by' -r -f -a "raw\t'The motion\'s own AnyTop features without the root\'s facing (a baseline; no model needed)'"
 complete -c mo-segment -l restarts -d 'K-means restarts from different seedings; the tightest clustering wins' -r
-complete -c mo-segment -l skeleton -d 'Skeleton of an NPY input: a skeleton document (skel-info) or a BVH file. Its AnyTop record also fixes the rig features are computed with' -r -F
+complete -c mo-segment -l skeleton -d 'The input\'s skeleton, a skeleton document (skel-info) or a BVH file: a BVH input is encoded with its AnyTop record (as \'mo-encode --skeleton\' does), an NPY input is checked against it' -r -F
 complete -c mo-segment -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-segment -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-segment -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r

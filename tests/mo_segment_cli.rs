@@ -1,5 +1,6 @@
 //! `mo-segment` end to end: finds the boundaries of a synthetic walk-stop-walk clip, is
-//! deterministic, feeds `mo-render --frame-labels`, and fails cleanly on bad input.
+//! deterministic, reads `mo-encode`'s NPY like the BVH, feeds `mo-render --frame-labels`, and
+//! fails cleanly on bad input.
 mod common;
 
 use common::{check_failure, ok, run, s, tempdir};
@@ -52,6 +53,15 @@ fn finds_walk_stop_walk_boundaries_deterministically() {
     }
     assert_eq!(next, 200);
 
+    // AnyTop features piped from mo-encode give the same labels (same rig, same features).
+    let npy = run("mo-encode", &[s(&bvh)], None);
+    ok(&npy, "encode");
+    let piped = run("mo-segment", &["--seed", "3"], Some(&npy.stdout));
+    ok(&piped, "segment the NPY");
+    let piped: serde_json::Value = serde_json::from_slice(&piped.stdout).unwrap();
+    assert_eq!(piped["frames"], 200);
+    assert_eq!(piped["labels"], json["labels"]);
+
     // mo-render reads it as frame labels.
     let sheet = dir.join("sheet.png");
     ok(&run("mo-render", &[s(&bvh), "--frame-labels", s(&a), "--sheet", s(&sheet), "--every", "20"], None), "render");
@@ -72,6 +82,9 @@ fn bad_input_exits_2_and_writes_nothing() {
     std::fs::write(&short, menagerie::bvh::write_string(&motion.first_frames(3).to_bvh(&skeleton))).unwrap();
     check_failure("mo-segment", "k > frames", &run("mo-segment", &[s(&short), "--k", "5", "-o", s(&out)], None), "5 clusters need at least 5 frames");
     check_failure("mo-segment", "bad window", &run("mo-segment", &[s(&short), "--window", "-1", "-o", s(&out)], None), "--window");
+    let batch = dir.join("batch.npy");
+    ok(&run("mo-encode", &[s(&short), s(&short), "-o", s(&batch)], None), "encode a batch");
+    check_failure("mo-segment", "a batch", &run("mo-segment", &[s(&batch), "-o", s(&out)], None), "batch of 2 samples");
     assert!(!out.exists(), "an error left an output file");
     assert!(std::fs::read_dir(&dir).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().starts_with('.')), "temp file left");
     let _ = std::fs::remove_dir_all(&dir);

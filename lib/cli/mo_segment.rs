@@ -3,15 +3,17 @@
 //! providers plug in), runs `segment::segment`, and writes JSON that `mo-render --frame-labels`
 //! reads.
 
-use crate::cli::load::{load_motions, read_skeleton, DecodeFrom, LoadOptions};
+use crate::cli::load::{read_skeleton, split_samples};
 use crate::cli::CommonOpts;
 use crate::document::AnyTopSection;
-use crate::io;
+use crate::io::{self, npy};
 use crate::motion::Motion;
-use crate::repr::anytop::{AnyTopOptions, RestSource};
+use crate::repr::anytop::{AnyTopOptions, RestSource, FEATURE_DIMS};
+use crate::repr::Features as ReprFeatures;
 use crate::segment::{self, Segmentation, SegmentOptions};
 use crate::skeleton::Skeleton;
-use anyhow::{bail, Context};
+use crate::bvh;
+use anyhow::{anyhow, bail, Context};
 use std::path::PathBuf;
 
 const EXAMPLES: &str = "\
@@ -19,7 +21,8 @@ EXAMPLES:
     mo-segment examples/data/biped.bvh
     mo-segment examples/data/quadruped.bvh --k 2 --min-segment 20 -o quadruped_segments.json
     mo-segment examples/data/dragon.bvh --pca-dims 4 --window 0.5 --seed 7 > dragon_segments.json
-    cat examples/data/crab.bvh | mo-segment - --k 4 --quiet";
+    cat examples/data/crab.bvh | mo-segment - --k 4 --quiet
+    mo-encode examples/data/spider.bvh | mo-segment --k 2";
 
 /// Split a motion into actions: per-frame labels and contiguous segments (JSON).
 ///
@@ -39,11 +42,13 @@ EXAMPLES:
 /// velocity needs the next one): the last frame takes the label before it. 'mo-render
 /// --frame-labels FILE' tints frames by this output.
 ///
-/// The input is a BVH file ('-' = stdin), or an NPY of AnyTop features decoded on --skeleton.
+/// The input is a BVH file, or an NPY of AnyTop features as mo-encode writes them by default
+/// ([frames, joints, 13], physical units), so 'mo-encode clip.bvh | mo-segment' gives the labels
+/// 'mo-segment clip.bvh' does; '-' = stdin. An NPY counts as 30 fps unless --skeleton is a BVH.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-segment", version, after_long_help = EXAMPLES)]
 pub struct Args {
-    /// Motion to segment: a BVH file, or an NPY feature file with --skeleton ('-' = stdin).
+    /// Motion to segment: a BVH file or an NPY of AnyTop features ('-' = stdin).
     #[arg(value_name = "INPUT", default_value = "-")]
     pub input: PathBuf,
     /// Clusters (kinds of action) to find; segments with the same label are the same kind.
@@ -65,8 +70,9 @@ pub struct Args {
     /// K-means restarts from different seedings; the tightest clustering wins.
     #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub restarts: u64,
-    /// Skeleton of an NPY input: a skeleton document (skel-info) or a BVH file. Its AnyTop
-    /// record also fixes the rig features are computed with.
+    /// The input's skeleton, a skeleton document (skel-info) or a BVH file: a BVH input is
+    /// encoded with its AnyTop record (as 'mo-encode --skeleton' does), an NPY input is checked
+    /// against it.
     #[arg(long, value_name = "PATH")]
     pub skeleton: Option<PathBuf>,
     #[command(flatten)]
@@ -88,46 +94,63 @@ impl Features {
     }
 }
 
-/// A motion to segment, with the AnyTop rig its features are computed on: what every feature
-/// provider gets.
+/// A motion to segment, as its AnyTop features: what every feature provider gets.
 pub struct Input {
+    /// File name for messages and the report.
     pub name: String,
-    pub skeleton: Skeleton,
-    pub motion: Motion,
-    pub section: AnyTopSection,
+    /// Motion frames the labels cover: the BVH's frames, or the features' frames + 1 for an
+    /// NPY (AnyTop features of an F-frame clip have F − 1 frames).
+    pub frames: usize,
+    /// Seconds per frame: the BVH's (or the --skeleton BVH's); 1/30 (AnyTop's rate) otherwise.
+    pub frame_time: f64,
+    /// `[frames − 1, joints, 13]` AnyTop features in physical units (as `mo-encode` writes them
+    /// without --normalise).
+    pub anytop: ReprFeatures,
+    /// The skeleton and the AnyTop record the features were made with, when known (a BVH
+    /// input, or an NPY with --skeleton); a model-based provider needs them.
+    pub skeleton: Option<(Skeleton, AnyTopSection)>,
 }
 
 impl Input {
-    /// A motion with a rig built on its own first two frames (AnyTop's rule for a clip without
-    /// a T-pose file, as `skel-info` builds it).
-    pub fn new(name: String, skeleton: Skeleton, motion: Motion) -> anyhow::Result<Input> {
+    /// A motion with a rig built on its own first two frames: AnyTop's rule for a clip without
+    /// a T-pose file, the rig `mo-encode` builds for a single input, so `mo-encode clip.bvh |
+    /// mo-segment` and `mo-segment clip.bvh` see the same features.
+    pub fn from_motion(name: String, skeleton: Skeleton, motion: &Motion) -> anyhow::Result<Input> {
         if motion.frames < 2 {
             bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
         }
         let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: name.clone() }, ..AnyTopOptions::default() };
         let section =
             AnyTopSection::new(&skeleton, &motion.first_frames(2), &options).with_context(|| format!("{name}: cannot build an AnyTop rig"))?;
-        Ok(Input { name, skeleton, motion, section })
+        Input::with_record(name, skeleton, motion, section)
     }
 
-    /// Seconds per frame (a broken frame time counts as 30 fps).
-    pub fn frame_time(&self) -> f64 {
-        if self.motion.frame_time.is_finite() && self.motion.frame_time > 0.0 { self.motion.frame_time } else { 1.0 / 30.0 }
+    /// A motion encoded with a given AnyTop record (a skeleton document's).
+    pub fn with_record(name: String, skeleton: Skeleton, motion: &Motion, section: AnyTopSection) -> anyhow::Result<Input> {
+        if motion.frames < 2 {
+            bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
+        }
+        let encoded = section.rig.encode(&skeleton, motion).map_err(|e| anyhow!("{name}: {e}"))?;
+        let frame_time = usable_frame_time(motion.frame_time);
+        Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)) })
     }
 }
 
-/// `--features raw`: `segment::raw_frame_features` of the clip's AnyTop encoding, one row per
+fn usable_frame_time(t: f64) -> f64 {
+    if t.is_finite() && t > 0.0 { t } else { 1.0 / 30.0 }
+}
+
+/// `--features raw`: `segment::raw_frame_features` of the clip's AnyTop features, one row per
 /// BVH frame but the last.
 pub fn raw_features(input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
-    let encoded = input.section.rig.encode(&input.skeleton, &input.motion).map_err(|e| anyhow::anyhow!("{}: {e}", input.name))?;
-    Ok(segment::raw_frame_features(&encoded.features))
+    Ok(segment::raw_frame_features(&input.anytop))
 }
 
 /// One feature vector per frame of `input` for `--features`, row t describing BVH frame t (rows
 /// may stop short of the last frames; `segment_input` gives those the last row's label; all rows
 /// the same length, finite). New feature kinds (DIFT) are one more `Features` variant and one
 /// more arm here, reading their own flags (model, step, layer, draws, `args.common.seed`) from
-/// `args`.
+/// `args` and the skeleton and rig from `input.skeleton`.
 pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
     match args.features {
         Features::Raw => raw_features(input),
@@ -146,7 +169,7 @@ pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOpti
         bail!("{}: no feature frames to segment", input.name);
     }
     let mut s = segment::segment(features, options, seed).with_context(|| format!("{}: cannot segment", input.name))?;
-    s.labels = segment::extend_labels(&s.labels, input.motion.frames);
+    s.labels = segment::extend_labels(&s.labels, input.frames);
     s.segments = segment::segments(&s.labels);
     Ok(s)
 }
@@ -160,7 +183,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let options = SegmentOptions {
         k: args.k as usize,
         pca_dims: args.pca_dims,
-        window: window_frames(args.window, input.frame_time()),
+        window: window_frames(args.window, input.frame_time),
         min_segment: args.min_segment,
         restarts: args.restarts as usize,
         ..SegmentOptions::default()
@@ -172,7 +195,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         eprintln!(
             "mo-segment: {}: {} frames, {} segments, {} clusters in {:.3} s",
             input.name,
-            input.motion.frames,
+            input.frames,
             result.segments.len(),
             result.clusters,
             started.elapsed().as_secs_f64()
@@ -182,24 +205,56 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     io::write_output(args.common.output.as_deref(), text.as_bytes()).context("cannot write the segmentation")
 }
 
+/// Read the input: a BVH (features on a rig from its own first frames), or an NPY of AnyTop
+/// features taken as they are (checked against --skeleton when given).
 fn load(args: &Args) -> anyhow::Result<Input> {
-    let options = LoadOptions { skeleton: args.skeleton.as_deref(), from: Some(DecodeFrom::Rotations) };
-    let mut loaded = load_motions(std::slice::from_ref(&args.input), &options)?;
-    if loaded.len() != 1 {
-        bail!("{}: expected one motion, found {} (an NPY batch? segment one sample at a time)", io::display_name(&args.input), loaded.len());
-    }
-    let l = loaded.remove(0);
-    match &args.skeleton {
-        // The skeleton's own record, so features match those mo-encode made with it.
-        Some(path) => {
-            let section = read_skeleton(path)?.record()?;
-            if l.motion.frames < 2 {
-                bail!("{}: {} frame(s); segmenting needs at least 2", l.name, l.motion.frames);
+    let name = io::display_name(&args.input);
+    let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
+    let skeleton = match &args.skeleton {
+        Some(path) => Some(read_skeleton(path)?),
+        None => None,
+    };
+    if !bytes.starts_with(b"\x93NUMPY") {
+        let parsed = bvh::parse_bytes(&bytes, &name)?;
+        drop(bytes);
+        let own = Skeleton::from_bvh(&parsed);
+        own.validate().with_context(|| name.clone())?;
+        let motion = Motion::from_bvh(&parsed, &own);
+        return match skeleton {
+            // The skeleton's own record, so the features are those mo-encode makes with it.
+            Some(arg) => {
+                if let Some(diff) = arg.skeleton.first_difference(&own) {
+                    bail!("{name} is not on the skeleton of {}: {diff}", arg.name);
+                }
+                let section = arg.record()?;
+                Input::with_record(name, own, &motion, section)
             }
-            Ok(Input { name: l.name, skeleton: l.skeleton, motion: l.motion, section })
-        }
-        None => Input::new(l.name, l.skeleton, l.motion),
+            None => Input::from_motion(name, own, &motion),
+        };
     }
+    let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name)?;
+    if batch {
+        bail!("{name}: a batch of {} samples; mo-segment takes one motion (a [frames, joints, 13] array)", samples.len());
+    }
+    let anytop = samples.remove(0);
+    if anytop.dims != FEATURE_DIMS {
+        bail!("{name}: expected AnyTop features with {FEATURE_DIMS} values per joint (mo-encode's default), found {}", anytop.dims);
+    }
+    if anytop.frames == 0 {
+        bail!("{name}: the features have no frames");
+    }
+    let (skeleton, frame_time) = match skeleton {
+        Some(arg) => {
+            if anytop.joints != arg.skeleton.len() {
+                bail!("{name}: the features have {} joints but the skeleton {} has {}", anytop.joints, arg.name, arg.skeleton.len());
+            }
+            let frame_time = arg.motion.as_ref().map_or(1.0 / 30.0, |m| usable_frame_time(m.frame_time));
+            let section = arg.record()?;
+            (Some((arg.skeleton, section)), frame_time)
+        }
+        None => (None, 1.0 / 30.0),
+    };
+    Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton })
 }
 
 /// The JSON report: one key per line, values compact (a per-frame label list stays one line).
@@ -208,8 +263,8 @@ fn report(args: &Args, input: &Input, options: &SegmentOptions, s: &Segmentation
     let explained = (s.explained_variance * 1e6).round() / 1e6;
     let fields: Vec<(&str, String)> = vec![
         ("file", to_string(&input.name)?),
-        ("frames", to_string(&input.motion.frames)?),
-        ("frame_time", to_string(&input.frame_time())?),
+        ("frames", to_string(&input.frames)?),
+        ("frame_time", to_string(&input.frame_time)?),
         ("features", to_string(&args.features.name())?),
         ("k", to_string(&options.k)?),
         ("clusters", to_string(&s.clusters)?),
