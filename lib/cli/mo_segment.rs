@@ -32,8 +32,11 @@ EXAMPLES:
 /// --pca-dims principal components; each frame is then described by the mean and standard
 /// deviation of its projections over --window seconds around it (single poses of a walk sweep
 /// through the gait cycle; statistics over about a cycle describe the action); k-means
-/// (k-means++ seeding, several restarts, --seed) groups the frames into --k clusters, and runs
-/// shorter than --min-segment frames are merged into their longer neighbour.
+/// (k-means++ seeding, several restarts, --seed) groups the frames into --k clusters; runs
+/// shorter than --min-segment frames are merged into their longer neighbour, and each boundary
+/// moves, within half a window, to the frame where the single-frame projections change most
+/// (window statistics place a change only to about half a window). Defaults are measured:
+/// 'cargo bench --bench segment', BENCHMARKS.md.
 ///
 /// Output: JSON with the file, its frame count and frame time, the options, the explained
 /// variance of the kept components, one label per frame ('labels', numbered by first
