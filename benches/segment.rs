@@ -53,7 +53,7 @@ fn synthetic() -> Vec<Case> {
                     [first, last] => vec![*first, last + 1],
                     _ => continue,
                 };
-                let input = Input::from_motion(format!("{name}_v{variant}_s{seed}"), clip.skeleton, &clip.motion).expect("synthetic clip");
+                let input = Input::from_motion(format!("{name}_v{variant}_s{seed}"), clip.skeleton, clip.motion).expect("synthetic clip");
                 out.push(Case { input, truth });
             }
         }
@@ -116,7 +116,7 @@ fn real() -> Vec<Case> {
         let short = |f: &str| Path::new(f).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let name = format!("{}+{}", short(fa), short(fb));
         let truth = vec![ma.frames];
-        match Input::from_motion(name, sa, &concat(&ma, &mb)) {
+        match Input::from_motion(name, sa, concat(&ma, &mb)) {
             Ok(input) => out.push(Case { input, truth }),
             Err(e) => println!("SKIP {fa} + {fb}: {e:#}"),
         }

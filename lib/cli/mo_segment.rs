@@ -1,7 +1,8 @@
-//! `mo-segment`: split a motion into actions. This file loads the motion (through `cli::load`),
-//! turns it into one feature vector per frame (`frame_features`: the place where feature
-//! providers plug in), runs `segment::segment`, and writes JSON that `mo-render --frame-labels`
-//! reads.
+//! `mo-segment`: split a motion into actions. This file reads the input (a BVH, encoded here
+//! with AnyTop's rig, or an NPY of AnyTop features as `mo-encode` writes them, so the two are
+//! interchangeable in a pipeline), turns it into one feature vector per frame
+//! (`frame_features`: the place where feature providers plug in), runs `segment::segment`, and
+//! writes JSON that `mo-render --frame-labels` reads.
 
 use crate::cli::load::{read_skeleton, split_samples};
 use crate::cli::CommonOpts;
@@ -112,13 +113,15 @@ pub struct Input {
     /// The skeleton and the AnyTop record the features were made with, when known (a BVH
     /// input, or an NPY with --skeleton); a model-based provider needs them.
     pub skeleton: Option<(Skeleton, AnyTopSection)>,
+    /// The motion itself for a BVH input (`None` for an NPY).
+    pub motion: Option<Motion>,
 }
 
 impl Input {
     /// A motion with a rig built on its own first two frames: AnyTop's rule for a clip without
     /// a T-pose file, the rig `mo-encode` builds for a single input, so `mo-encode clip.bvh |
     /// mo-segment` and `mo-segment clip.bvh` see the same features.
-    pub fn from_motion(name: String, skeleton: Skeleton, motion: &Motion) -> anyhow::Result<Input> {
+    pub fn from_motion(name: String, skeleton: Skeleton, motion: Motion) -> anyhow::Result<Input> {
         if motion.frames < 2 {
             bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
         }
@@ -129,13 +132,13 @@ impl Input {
     }
 
     /// A motion encoded with a given AnyTop record (a skeleton document's).
-    pub fn with_record(name: String, skeleton: Skeleton, motion: &Motion, section: AnyTopSection) -> anyhow::Result<Input> {
+    pub fn with_record(name: String, skeleton: Skeleton, motion: Motion, section: AnyTopSection) -> anyhow::Result<Input> {
         if motion.frames < 2 {
             bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
         }
-        let encoded = section.rig.encode(&skeleton, motion).map_err(|e| anyhow!("{name}: {e}"))?;
+        let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| anyhow!("{name}: {e}"))?;
         let frame_time = usable_frame_time(motion.frame_time);
-        Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)) })
+        Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)), motion: Some(motion) })
     }
 }
 
@@ -230,9 +233,9 @@ fn load(args: &Args) -> anyhow::Result<Input> {
                     bail!("{name} is not on the skeleton of {}: {diff}", arg.name);
                 }
                 let section = arg.record()?;
-                Input::with_record(name, own, &motion, section)
+                Input::with_record(name, own, motion, section)
             }
-            None => Input::from_motion(name, own, &motion),
+            None => Input::from_motion(name, own, motion),
         };
     }
     let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name)?;
@@ -257,7 +260,7 @@ fn load(args: &Args) -> anyhow::Result<Input> {
         }
         None => (None, 1.0 / 30.0),
     };
-    Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton })
+    Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton, motion: None })
 }
 
 /// The JSON report: one key per line, values compact (a per-frame label list stays one line).
