@@ -18,5 +18,6 @@ pub mod nn;
 pub mod render;
 pub mod repr;
 pub mod retarget;
+pub mod segment;
 pub mod skeleton;
 pub mod synth;

@@ -14,6 +14,7 @@ pub mod mo_metrics;
 pub mod mo_render;
 pub mod mo_retarget;
 pub mod mo_sample;
+pub mod mo_segment;
 pub mod mo_train;
 pub mod skel_aug;
 pub mod skel_info;
@@ -82,5 +83,6 @@ pub fn all_commands() -> Vec<clap::Command> {
         mo_train::Args::command(),
         mo_sample::Args::command(),
         mo_dift::Args::command(),
+        mo_segment::Args::command(),
     ]
 }

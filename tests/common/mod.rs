@@ -64,6 +64,7 @@ pub fn bin(name: &str) -> Command {
         "mo-train" => env!("CARGO_BIN_EXE_mo-train"),
         "mo-sample" => env!("CARGO_BIN_EXE_mo-sample"),
         "mo-dift" => env!("CARGO_BIN_EXE_mo-dift"),
+        "mo-segment" => env!("CARGO_BIN_EXE_mo-segment"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);

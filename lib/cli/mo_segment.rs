@@ -1,0 +1,292 @@
+//! `mo-segment`: split a motion into actions. This file reads the input (a BVH, encoded here
+//! with AnyTop's rig, or an NPY of AnyTop features as `mo-encode` writes them, so the two are
+//! interchangeable in a pipeline), turns it into one feature vector per frame
+//! (`frame_features`: the place where feature providers plug in), runs `segment::segment`, and
+//! writes JSON that `mo-render --frame-labels` reads.
+
+use crate::cli::load::{read_skeleton, split_samples};
+use crate::cli::CommonOpts;
+use crate::document::AnyTopSection;
+use crate::io::{self, npy};
+use crate::motion::Motion;
+use crate::repr::anytop::{AnyTopOptions, RestSource, FEATURE_DIMS};
+use crate::repr::Features as ReprFeatures;
+use crate::segment::{self, Segmentation, SegmentOptions};
+use crate::skeleton::Skeleton;
+use crate::bvh;
+use anyhow::{anyhow, bail, Context};
+use std::path::PathBuf;
+
+const EXAMPLES: &str = "\
+EXAMPLES:
+    mo-segment examples/data/biped.bvh
+    mo-segment examples/data/quadruped.bvh --k 2 --min-segment 20 -o quadruped_segments.json
+    mo-segment examples/data/dragon.bvh --pca-dims 4 --window 0.5 --seed 7 > dragon_segments.json
+    cat examples/data/crab.bvh | mo-segment - --k 4 --quiet
+    mo-encode examples/data/spider.bvh | mo-segment --k 2";
+
+/// Split a motion into actions: per-frame labels and contiguous segments (JSON).
+///
+/// Each frame of the motion becomes a feature vector (--features): 'raw' is the motion's own
+/// AnyTop features, every joint's 13 values (root-relative position, 6D rotation, velocity,
+/// foot contact) except the root's facing. The vectors are centred and projected on their top
+/// --pca-dims principal components; each frame is then described by the mean and standard
+/// deviation of its projections over --window seconds around it (single poses of a walk sweep
+/// through the gait cycle; statistics over about a cycle describe the action); k-means
+/// (k-means++ seeding, several restarts, --seed) groups the frames into --k clusters; runs
+/// shorter than --min-segment frames are merged into their longer neighbour, and each boundary
+/// moves, within half a window, to the frame where the single-frame projections change most
+/// (window statistics place a change only to about half a window). Defaults are measured:
+/// 'cargo bench --bench segment', BENCHMARKS.md.
+///
+/// Output: JSON with the file, its frame count and frame time, the options, the explained
+/// variance of the kept components, one label per frame ('labels', numbered by first
+/// appearance: frame 0 has label 0) and the contiguous 'segments' [{start, end, label}] with end
+/// exclusive, in BVH frames. AnyTop features have one frame fewer than the BVH (a frame's
+/// velocity needs the next one): the last frame takes the label before it. 'mo-render
+/// --frame-labels FILE' tints frames by this output.
+///
+/// The input is a BVH file, or an NPY of AnyTop features as mo-encode writes them by default
+/// ([frames, joints, 13], physical units), so 'mo-encode clip.bvh | mo-segment' gives the labels
+/// 'mo-segment clip.bvh' does; '-' = stdin. An NPY counts as 30 fps unless --skeleton is a BVH.
+#[derive(clap::Parser, Debug)]
+#[command(name = "mo-segment", version, after_long_help = EXAMPLES)]
+pub struct Args {
+    /// Motion to segment: a BVH file or an NPY of AnyTop features ('-' = stdin).
+    #[arg(value_name = "INPUT", default_value = "-")]
+    pub input: PathBuf,
+    /// Clusters (kinds of action) to find; segments with the same label are the same kind.
+    #[arg(long, value_name = "K", default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=64))]
+    pub k: u64,
+    /// Principal components kept (0 = cluster the features as they are).
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub pca_dims: usize,
+    /// Temporal context: mean and std of each component over this many seconds around a frame
+    /// (0 = single frames).
+    #[arg(long, value_name = "SECONDS", default_value_t = 1.0, allow_negative_numbers = true)]
+    pub window: f64,
+    /// Shortest segment in frames; shorter runs are merged into their longer neighbour.
+    #[arg(long, value_name = "FRAMES", default_value_t = 10)]
+    pub min_segment: usize,
+    /// What each frame is described by.
+    #[arg(long, value_enum, value_name = "KIND", default_value_t = Features::Raw)]
+    pub features: Features,
+    /// K-means restarts from different seedings; the tightest clustering wins.
+    #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub restarts: u64,
+    /// The input's skeleton, a skeleton document (skel-info) or a BVH file: a BVH input is
+    /// encoded with its AnyTop record (as 'mo-encode --skeleton' does), an NPY input is checked
+    /// against it.
+    #[arg(long, value_name = "PATH")]
+    pub skeleton: Option<PathBuf>,
+    #[command(flatten)]
+    pub common: CommonOpts,
+}
+
+/// Per-frame descriptions `mo-segment` can cluster.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Features {
+    /// The motion's own AnyTop features without the root's facing (a baseline; no model needed).
+    Raw,
+}
+
+impl Features {
+    pub fn name(self) -> &'static str {
+        match self {
+            Features::Raw => "raw",
+        }
+    }
+}
+
+/// A motion to segment, as its AnyTop features: what every feature provider gets.
+pub struct Input {
+    /// File name for messages and the report.
+    pub name: String,
+    /// Motion frames the labels cover: the BVH's frames, or the features' frames + 1 for an
+    /// NPY (AnyTop features of an F-frame clip have F − 1 frames).
+    pub frames: usize,
+    /// Seconds per frame: the BVH's (or the --skeleton BVH's); 1/30 (AnyTop's rate) otherwise.
+    pub frame_time: f64,
+    /// `[frames − 1, joints, 13]` AnyTop features in physical units (as `mo-encode` writes them
+    /// without --normalise).
+    pub anytop: ReprFeatures,
+    /// The skeleton and the AnyTop record the features were made with, when known (a BVH
+    /// input, or an NPY with --skeleton); a model-based provider needs them.
+    pub skeleton: Option<(Skeleton, AnyTopSection)>,
+    /// The motion itself for a BVH input (`None` for an NPY).
+    pub motion: Option<Motion>,
+}
+
+impl Input {
+    /// A motion with a rig built on its own first two frames: AnyTop's rule for a clip without
+    /// a T-pose file, the rig `mo-encode` builds for a single input, so `mo-encode clip.bvh |
+    /// mo-segment` and `mo-segment clip.bvh` see the same features.
+    pub fn from_motion(name: String, skeleton: Skeleton, motion: Motion) -> anyhow::Result<Input> {
+        if motion.frames < 2 {
+            bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
+        }
+        let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: name.clone() }, ..AnyTopOptions::default() };
+        let section =
+            AnyTopSection::new(&skeleton, &motion.first_frames(2), &options).with_context(|| format!("{name}: cannot build an AnyTop rig"))?;
+        Input::with_record(name, skeleton, motion, section)
+    }
+
+    /// A motion encoded with a given AnyTop record (a skeleton document's).
+    pub fn with_record(name: String, skeleton: Skeleton, motion: Motion, section: AnyTopSection) -> anyhow::Result<Input> {
+        if motion.frames < 2 {
+            bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
+        }
+        let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| anyhow!("{name}: {e}"))?;
+        let frame_time = usable_frame_time(motion.frame_time);
+        Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)), motion: Some(motion) })
+    }
+}
+
+fn usable_frame_time(t: f64) -> f64 {
+    if t.is_finite() && t > 0.0 { t } else { 1.0 / 30.0 }
+}
+
+/// `--features raw`: `segment::raw_frame_features` of the clip's AnyTop features, one row per
+/// BVH frame but the last.
+pub fn raw_features(input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
+    Ok(segment::raw_frame_features(&input.anytop))
+}
+
+/// One feature vector per frame of `input` for `--features`, row t describing BVH frame t (rows
+/// may stop short of the last frames; `segment_input` gives those the last row's label; all rows
+/// the same length, finite). New feature kinds (DIFT) are one more `Features` variant and one
+/// more arm here, reading their own flags (model, step, layer, draws, `args.common.seed`) from
+/// `args` and the skeleton and rig from `input.skeleton`.
+pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
+    match args.features {
+        Features::Raw => raw_features(input),
+    }
+}
+
+/// `--window` seconds as frames at `frame_time` (0 = none).
+pub fn window_frames(seconds: f64, frame_time: f64) -> usize {
+    if seconds > 0.0 && frame_time > 0.0 { (seconds / frame_time).round() as usize } else { 0 }
+}
+
+/// Segment `features` of `input` and return the result in BVH frames (labels extended to every
+/// frame of the motion, segments recomputed on them).
+pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOptions, seed: u64) -> anyhow::Result<Segmentation> {
+    if features.is_empty() {
+        bail!("{}: no feature frames to segment", input.name);
+    }
+    let mut s = segment::segment(features, options, seed).with_context(|| format!("{}: cannot segment", input.name))?;
+    s.labels = segment::extend_labels(&s.labels, input.frames);
+    s.segments = segment::segments(&s.labels);
+    Ok(s)
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    args.common.init_threads();
+    if !(args.window.is_finite() && args.window >= 0.0) {
+        bail!("--window must be a number of seconds >= 0, found {}", args.window);
+    }
+    let input = load(args)?;
+    let options = SegmentOptions {
+        k: args.k as usize,
+        pca_dims: args.pca_dims,
+        window: window_frames(args.window, input.frame_time),
+        min_segment: args.min_segment,
+        restarts: args.restarts as usize,
+        ..SegmentOptions::default()
+    };
+    let started = std::time::Instant::now();
+    let features = frame_features(args, &input)?;
+    let result = segment_input(&input, &features, &options, args.common.seed)?;
+    if args.common.verbose {
+        eprintln!(
+            "mo-segment: {}: {} frames, {} segments, {} clusters in {:.3} s",
+            input.name,
+            input.frames,
+            result.segments.len(),
+            result.clusters,
+            started.elapsed().as_secs_f64()
+        );
+    }
+    let text = report(args, &input, &options, &result)?;
+    io::write_output(args.common.output.as_deref(), text.as_bytes()).context("cannot write the segmentation")
+}
+
+/// Read the input: a BVH (features on a rig from its own first frames), or an NPY of AnyTop
+/// features taken as they are (checked against --skeleton when given).
+fn load(args: &Args) -> anyhow::Result<Input> {
+    let name = io::display_name(&args.input);
+    let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
+    let skeleton = match &args.skeleton {
+        Some(path) => Some(read_skeleton(path)?),
+        None => None,
+    };
+    if !bytes.starts_with(b"\x93NUMPY") {
+        let parsed = bvh::parse_bytes(&bytes, &name)?;
+        drop(bytes);
+        let own = Skeleton::from_bvh(&parsed);
+        own.validate().with_context(|| name.clone())?;
+        let motion = Motion::from_bvh(&parsed, &own);
+        return match skeleton {
+            // The skeleton's own record, so the features are those mo-encode makes with it.
+            Some(arg) => {
+                if let Some(diff) = arg.skeleton.first_difference(&own) {
+                    bail!("{name} is not on the skeleton of {}: {diff}", arg.name);
+                }
+                let section = arg.record()?;
+                Input::with_record(name, own, motion, section)
+            }
+            None => Input::from_motion(name, own, motion),
+        };
+    }
+    let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name)?;
+    if batch {
+        bail!("{name}: a batch of {} samples; mo-segment takes one motion (a [frames, joints, 13] array)", samples.len());
+    }
+    let anytop = samples.remove(0);
+    if anytop.dims != FEATURE_DIMS {
+        bail!("{name}: expected AnyTop features with {FEATURE_DIMS} values per joint (mo-encode's default), found {}", anytop.dims);
+    }
+    if anytop.frames == 0 {
+        bail!("{name}: the features have no frames");
+    }
+    let (skeleton, frame_time) = match skeleton {
+        Some(arg) => {
+            if anytop.joints != arg.skeleton.len() {
+                bail!("{name}: the features have {} joints but the skeleton {} has {}", anytop.joints, arg.name, arg.skeleton.len());
+            }
+            let frame_time = arg.motion.as_ref().map_or(1.0 / 30.0, |m| usable_frame_time(m.frame_time));
+            let section = arg.record()?;
+            (Some((arg.skeleton, section)), frame_time)
+        }
+        None => (None, 1.0 / 30.0),
+    };
+    Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton, motion: None })
+}
+
+/// The JSON report: one key per line, values compact (a per-frame label list stays one line).
+fn report(args: &Args, input: &Input, options: &SegmentOptions, s: &Segmentation) -> anyhow::Result<String> {
+    use serde_json::to_string;
+    let explained = (s.explained_variance * 1e6).round() / 1e6;
+    let fields: Vec<(&str, String)> = vec![
+        ("file", to_string(&input.name)?),
+        ("frames", to_string(&input.frames)?),
+        ("frame_time", to_string(&input.frame_time)?),
+        ("features", to_string(&args.features.name())?),
+        ("k", to_string(&options.k)?),
+        ("clusters", to_string(&s.clusters)?),
+        ("pca_dims", to_string(&s.pca_dims)?),
+        ("explained_variance", to_string(&explained)?),
+        ("window_frames", to_string(&options.window)?),
+        ("min_segment", to_string(&options.min_segment)?),
+        ("seed", to_string(&args.common.seed)?),
+        ("labels", to_string(&s.labels)?),
+        ("segments", to_string(&s.segments)?),
+    ];
+    let mut out = String::from("{\n");
+    for (i, (key, value)) in fields.iter().enumerate() {
+        let comma = if i + 1 < fields.len() { "," } else { "" };
+        out.push_str(&format!("  \"{key}\": {value}{comma}\n"));
+    }
+    out.push_str("}\n");
+    Ok(out)
+}
