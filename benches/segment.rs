@@ -23,7 +23,9 @@
 
 mod common;
 
-use menagerie::cli::mo_segment::{raw_features, segment_input, window_frames, Input};
+use menagerie::cli::mo_segment::{dift_features, raw_features, segment_input, window_frames, Input};
+use menagerie::diffusion::checkpoint;
+use menagerie::dift::DiftOptions;
 use menagerie::motion::Motion;
 use menagerie::segment::{boundaries, boundary_errors, SegmentOptions};
 use menagerie::skeleton::Skeleton;
@@ -200,7 +202,11 @@ fn row(family: &str, provider: &str, c: &Config, s: &Score) {
 fn main() {
     let verbose = std::env::var_os("SEGMENT_VERBOSE").is_some();
     let families = [("synthetic", synthetic()), ("real", real())];
-    let providers: Vec<(&str, Provider)> = vec![("raw", &raw_features)];
+    let model = checkpoint::frozen_default(&candle_core::Device::Cpu).expect("the built-in model");
+    let dift = |input: &Input| dift_features(&model, input, &DiftOptions::TEMPORAL);
+    // DIFT runs the denoiser per clip: only the main window settings for it.
+    let providers: Vec<(&str, Provider, &[usize])> =
+        vec![("raw", &raw_features, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]), ("dift", &dift, &[0, 1, 4, 6])];
     let configs = vec![
         config("single frames k3 pca8 min10", 3, 8, 0.0, 10, false, true),
         config("window 0.5s k3 pca8 min10", 3, 8, 0.5, 10, false, true),
@@ -225,8 +231,8 @@ fn main() {
         if cases.is_empty() {
             continue;
         }
-        for (pname, provider) in &providers {
-            for c in &configs {
+        for (pname, provider, chosen) in &providers {
+            for c in chosen.iter().map(|&i| &configs[i]) {
                 let s = evaluate(cases, *provider, c, 0, verbose);
                 row(family, pname, c, &s);
             }

@@ -23,7 +23,7 @@ _mo__segment() {
 
     case "${cmd}" in
         mo__segment)
-            opts="-o -q -v -h -V --k --pca-dims --window --min-segment --features --restarts --skeleton --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --k --pca-dims --window --min-segment --features --model --t --layer --draws --restarts --skeleton --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -46,7 +46,23 @@ _mo__segment() {
                     return 0
                     ;;
                 --features)
-                    COMPREPLY=($(compgen -W "raw" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "raw dift" -- "${cur}"))
+                    return 0
+                    ;;
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --t)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --layer)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --draws)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --restarts)

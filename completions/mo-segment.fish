@@ -2,7 +2,12 @@ complete -c mo-segment -l k -d 'Clusters (kinds of action) to find; segments wit
 complete -c mo-segment -l pca-dims -d 'Principal components kept (0 = cluster the features as they are)' -r
 complete -c mo-segment -l window -d 'Temporal context: mean and std of each component over this many seconds around a frame (0 = single frames)' -r
 complete -c mo-segment -l min-segment -d 'Shortest segment in frames; shorter runs are merged into their longer neighbour' -r
-complete -c mo-segment -l features -d 'What each frame is described by' -r -f -a "raw\t'The motion\'s own AnyTop features without the root\'s facing (a baseline; no model needed)'"
+complete -c mo-segment -l features -d 'What each frame is described by' -r -f -a "raw\t'The motion\'s own AnyTop features without the root\'s facing (a baseline; no model needed)'
+dift\t'Diffusion features (AnyTop §5: the denoiser\'s activations, averaged over joints), as `mo-dift` computes them'"
+complete -c mo-segment -l model -d 'With --features dift: model directory written by mo-train [default: the built-in model]' -r -F
+complete -c mo-segment -l t -d 'With --features dift: diffusion step the motion is noised to' -r
+complete -c mo-segment -l layer -d 'With --features dift: layer whose activations are read (0-based)' -r
+complete -c mo-segment -l draws -d 'With --features dift: noise draws averaged' -r
 complete -c mo-segment -l restarts -d 'K-means restarts from different seedings; the tightest clustering wins' -r
 complete -c mo-segment -l skeleton -d 'The input\'s skeleton, a skeleton document (skel-info) or a BVH file: a BVH input is encoded with its AnyTop record (as \'mo-encode --skeleton\' does), an NPY input is checked against it' -r -F
 complete -c mo-segment -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F

@@ -26,22 +26,27 @@ fn finds_walk_stop_walk_boundaries_deterministically() {
     let dir = tempdir("wsw");
     let (bvh, truth) = walk_stop_walk(&dir);
     let (a, b) = (dir.join("a.json"), dir.join("b.json"));
-    ok(&run("mo-segment", &[s(&bvh), "--seed", "3", "-o", s(&a)], None), "segment");
-    ok(&run("mo-segment", &[s(&bvh), "--seed", "3", "-o", s(&b), "--threads", "1"], None), "segment again");
-    let bytes = std::fs::read(&a).unwrap();
-    assert_eq!(bytes, std::fs::read(&b).unwrap(), "same seed, different output");
-
-    let json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
-    assert_eq!(json["frames"], 200);
-    assert_eq!(json["features"], "raw");
-    let labels = labels(&json);
-    assert_eq!(labels.len(), 200, "one label per BVH frame");
-    assert_eq!(labels[0], 0);
-    let predicted = menagerie::segment::boundaries(&labels);
-    let errors = menagerie::segment::boundary_errors(&predicted, &truth);
-    for (t, e) in truth.iter().zip(&errors.errors) {
-        assert!(e.is_some_and(|e| e <= 6), "boundary {t}: nearest prediction {e:?} (predicted {predicted:?})");
+    let mut by_kind = Vec::new();
+    for kind in ["dift", "raw"] {
+        ok(&run("mo-segment", &[s(&bvh), "--seed", "3", "--features", kind, "-o", s(&a)], None), "segment");
+        ok(&run("mo-segment", &[s(&bvh), "--seed", "3", "--features", kind, "-o", s(&b), "--threads", "1"], None), "segment again");
+        let bytes = std::fs::read(&a).unwrap();
+        assert_eq!(bytes, std::fs::read(&b).unwrap(), "{kind}: same seed, different output");
+        let json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        assert_eq!(json["frames"], 200);
+        assert_eq!(json["features"], kind);
+        let labels = labels(&json);
+        assert_eq!(labels.len(), 200, "one label per BVH frame");
+        assert_eq!(labels[0], 0);
+        let predicted = menagerie::segment::boundaries(&labels);
+        let errors = menagerie::segment::boundary_errors(&predicted, &truth);
+        for (t, e) in truth.iter().zip(&errors.errors) {
+            assert!(e.is_some_and(|e| e <= 6), "{kind}: boundary {t}: nearest prediction {e:?} (predicted {predicted:?})");
+        }
+        by_kind.push(json);
     }
+    let json = by_kind.pop().unwrap();
+    let labels = labels(&json);
     // Segments cover the clip in order, end exclusive, and agree with the labels.
     let segments = json["segments"].as_array().unwrap();
     let mut next = 0;
@@ -56,7 +61,7 @@ fn finds_walk_stop_walk_boundaries_deterministically() {
     // AnyTop features piped from mo-encode give the same labels (same rig, same features).
     let npy = run("mo-encode", &[s(&bvh)], None);
     ok(&npy, "encode");
-    let piped = run("mo-segment", &["--seed", "3"], Some(&npy.stdout));
+    let piped = run("mo-segment", &["--seed", "3", "--features", "raw"], Some(&npy.stdout));
     ok(&piped, "segment the NPY");
     let piped: serde_json::Value = serde_json::from_slice(&piped.stdout).unwrap();
     assert_eq!(piped["frames"], 200);
@@ -76,6 +81,11 @@ fn bad_input_exits_2_and_writes_nothing() {
     let text = dir.join("notes.bvh");
     std::fs::write(&text, "hello\n").unwrap();
     check_failure("mo-segment", "not a BVH", &run("mo-segment", &[s(&text), "-o", s(&out)], None), "notes.bvh");
+    // DIFT needs the skeleton an NPY of features does not carry.
+    let quad = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/quadruped.bvh");
+    let npy = run("mo-encode", &[s(&quad)], None);
+    ok(&npy, "encode");
+    check_failure("mo-segment", "NPY without skeleton", &run("mo-segment", &["-o", s(&out)], Some(&npy.stdout)), "give --skeleton");
     // Three frames give two feature frames: too few for five clusters.
     let short = dir.join("short.bvh");
     let (skeleton, motion) = menagerie::synth::creature("crab", 0).unwrap();

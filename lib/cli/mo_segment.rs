@@ -6,6 +6,8 @@
 
 use crate::cli::load::{read_skeleton, split_samples};
 use crate::cli::CommonOpts;
+use crate::diffusion::{checkpoint, Schedule};
+use crate::dift::{self, DiftOptions};
 use crate::document::AnyTopSection;
 use crate::io::{self, npy};
 use crate::motion::Motion;
@@ -23,13 +25,17 @@ EXAMPLES:
     mo-segment examples/data/quadruped.bvh --k 2 --min-segment 20 -o quadruped_segments.json
     mo-segment examples/data/dragon.bvh --pca-dims 4 --window 0.5 --seed 7 > dragon_segments.json
     cat examples/data/crab.bvh | mo-segment - --k 4 --quiet
-    mo-encode examples/data/spider.bvh | mo-segment --k 2";
+    mo-encode examples/data/spider.bvh | mo-segment --skeleton examples/data/spider.bvh --k 2
+    mo-segment examples/data/snake.bvh --features raw --window 0.5";
 
 /// Split a motion into actions: per-frame labels and contiguous segments (JSON).
 ///
-/// Each frame of the motion becomes a feature vector (--features): 'raw' is the motion's own
-/// AnyTop features, every joint's 13 values (root-relative position, 6D rotation, velocity,
-/// foot contact) except the root's facing. The vectors are centred and projected on their top
+/// Each frame of the motion becomes a feature vector (--features): 'dift' (default) is the
+/// trained denoiser's activations (AnyTop §5: the motion noised to step --t, the layer --layer
+/// output averaged over joints and over --draws noise draws, as mo-dift computes them; the
+/// built-in model unless --model); 'raw' is the motion's own AnyTop features, every joint's 13
+/// values (root-relative position, 6D rotation, velocity, foot contact) except the root's
+/// facing — a baseline that needs no model. The vectors are centred and projected on their top
 /// --pca-dims principal components; each frame is then described by the mean and standard
 /// deviation of its projections over --window seconds around it (single poses of a walk sweep
 /// through the gait cycle; statistics over about a cycle describe the action); k-means
@@ -69,8 +75,20 @@ pub struct Args {
     #[arg(long, value_name = "FRAMES", default_value_t = 10)]
     pub min_segment: usize,
     /// What each frame is described by.
-    #[arg(long, value_enum, value_name = "KIND", default_value_t = Features::Raw)]
+    #[arg(long, value_enum, value_name = "KIND", default_value_t = Features::Dift)]
     pub features: Features,
+    /// With --features dift: model directory written by mo-train [default: the built-in model].
+    #[arg(long, value_name = "DIR")]
+    pub model: Option<PathBuf>,
+    /// With --features dift: diffusion step the motion is noised to.
+    #[arg(long, value_name = "T", default_value_t = DiftOptions::TEMPORAL.t)]
+    pub t: usize,
+    /// With --features dift: layer whose activations are read (0-based).
+    #[arg(long, value_name = "L", default_value_t = DiftOptions::TEMPORAL.layer)]
+    pub layer: usize,
+    /// With --features dift: noise draws averaged.
+    #[arg(long, value_name = "N", default_value_t = DiftOptions::TEMPORAL.draws as u64, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub draws: u64,
     /// K-means restarts from different seedings; the tightest clustering wins.
     #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub restarts: u64,
@@ -88,12 +106,16 @@ pub struct Args {
 pub enum Features {
     /// The motion's own AnyTop features without the root's facing (a baseline; no model needed).
     Raw,
+    /// Diffusion features (AnyTop §5: the denoiser's activations, averaged over joints), as
+    /// `mo-dift` computes them.
+    Dift,
 }
 
 impl Features {
     pub fn name(self) -> &'static str {
         match self {
             Features::Raw => "raw",
+            Features::Dift => "dift",
         }
     }
 }
@@ -160,7 +182,28 @@ pub fn raw_features(input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
 pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
     match args.features {
         Features::Raw => raw_features(input),
+        Features::Dift => {
+            let device = candle_core::Device::Cpu;
+            let model = match &args.model {
+                Some(dir) => checkpoint::frozen(dir, &device)?,
+                None => checkpoint::frozen_default(&device)?,
+            };
+            let opts = DiftOptions { t: args.t, layer: args.layer, draws: args.draws as usize, seed: args.common.seed, ..DiftOptions::TEMPORAL };
+            dift_features(&model, input, &opts)
+        }
     }
+}
+
+/// `--features dift`: DIFT features averaged over joints, one row per AnyTop feature frame.
+pub fn dift_features(model: &checkpoint::Frozen, input: &Input, opts: &DiftOptions) -> anyhow::Result<Vec<Vec<f64>>> {
+    let Some((skeleton, section)) = &input.skeleton else {
+        bail!("{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input", input.name);
+    };
+    let prepared = dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name)?;
+    let schedule = Schedule::cosine(model.info.schedule_steps);
+    let f = dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, &candle_core::Device::Cpu)
+        .with_context(|| input.name.clone())?;
+    Ok(f.per_frame().into_iter().map(|row| row.into_iter().map(f64::from).collect()).collect())
 }
 
 /// `--window` seconds as frames at `frame_time` (0 = none).

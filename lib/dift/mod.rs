@@ -139,9 +139,15 @@ pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file
     }
     let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..AnyTopOptions::default() };
     let section = AnyTopSection::new(skeleton, &motion.first_frames(2), &options).with_context(|| format!("{file}: cannot build an AnyTop rig"))?;
-    let mut features = section.rig.encode(skeleton, motion).map_err(|e| anyhow::anyhow!("{file}: {e}"))?.features;
+    let features = section.rig.encode(skeleton, motion).map_err(|e| anyhow::anyhow!("{file}: {e}"))?.features;
+    prepare_encoded(info, skeleton, &section.rest_row, features, file)
+}
+
+/// `prepare` for a motion already encoded (physical AnyTop features) with a rig whose P_S is
+/// `rest_row`, e.g. an NPY from `mo-encode` and its skeleton document.
+pub fn prepare_encoded(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], mut features: Features, file: &str) -> anyhow::Result<Prepared> {
     let measured = AnyTopStats::compute([&features]).map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
-    let condition = SkeletonCondition::with_stats(info, skeleton, &section.rest_row, measured, StatsSource::Measured).with_context(|| file.to_string())?;
+    let condition = SkeletonCondition::with_stats(info, skeleton, rest_row, measured, StatsSource::Measured).with_context(|| file.to_string())?;
     condition.stats.normalise(&mut features).map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
     Ok(Prepared { condition, features })
 }
