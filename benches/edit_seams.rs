@@ -13,11 +13,10 @@
 use candle_core::Device;
 use menagerie::cli::load::read_skeleton;
 use menagerie::diffusion::edit::{boundary_jumps, jump_distribution, jump_distribution_of, sample_edit, seam_jump, KeepMask};
-use menagerie::diffusion::sample::{sample, Condition, SampleOptions};
+use menagerie::diffusion::condition::SkeletonCondition;
+use menagerie::diffusion::sample::{sample, SampleOptions};
 use menagerie::diffusion::{checkpoint, Sampler, Schedule};
-use menagerie::embed::NameTable;
 use menagerie::repr::Features;
-use menagerie::skeleton::topology;
 use std::path::PathBuf;
 
 fn main() {
@@ -33,20 +32,16 @@ fn main() {
     let arg = read_skeleton(&clip).expect("clip");
     let skeleton = &arg.skeleton;
     let section = arg.record().expect("rig");
-    let Some(trained) = loaded.info.skeletons.iter().find(|t| t.matches(skeleton)) else {
+    if !loaded.info.skeletons.iter().any(|t| t.matches(skeleton)) {
         println!("SKIP edit_seams: {} is not a skeleton the model was trained on", clip.display());
         return;
-    };
-    let stats = trained.stats.clone();
+    }
     let encoded = section.rig.encode(skeleton, arg.motion.as_ref().unwrap()).expect("encode");
     let reference = encoded.features;
     let (frames, j) = (reference.frames, reference.joints);
-    let mut rest = Features { frames: 1, joints: j, dims: 13, data: section.rest_row.concat() };
-    stats.normalise(&mut rest).unwrap();
-    let names = NameTable::builtin().unwrap().embed_skeleton(skeleton);
-    let relations = topology::relations(skeleton);
-    let distances = topology::distances(skeleton, loaded.info.dmax);
-    let cond = Condition { rest_row: &rest.data, relations: &relations, distances: &distances, names: &names, stats: &stats };
+    let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, None).expect("condition");
+    let stats = &condition.stats;
+    let cond = condition.condition();
     let schedule = Schedule::cosine(loaded.info.schedule_steps);
 
     let quarter = frames / 4;
