@@ -62,6 +62,13 @@ impl AnyTopSection {
         Ok(AnyTopSection { rig, rest_row, stats: None })
     }
 
+    /// The record of a lone clip: the rig on its own first two frames (AnyTop's rule without a
+    /// T-pose file, the rig `mo-encode` builds for a single input), no statistics.
+    pub fn of_clip(skeleton: &Skeleton, motion: &Motion, file: &str) -> Result<AnyTopSection, AnyTopError> {
+        let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..AnyTopOptions::default() };
+        AnyTopSection::new(skeleton, &motion.first_frames(2), &options)
+    }
+
     /// `new` with default options, plus statistics over `clips` (those with at least two frames).
     pub fn build(skeleton: &Skeleton, rest: &Motion, source: RestSource, clips: &[&Motion]) -> Result<AnyTopSection, AnyTopError> {
         let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };

@@ -11,7 +11,7 @@ use crate::dift::{self, DiftOptions};
 use crate::document::AnyTopSection;
 use crate::io::{self, npy};
 use crate::motion::Motion;
-use crate::repr::anytop::{AnyTopOptions, RestSource, FEATURE_DIMS};
+use crate::repr::anytop::FEATURE_DIMS;
 use crate::repr::Features as ReprFeatures;
 use crate::segment::{self, Segmentation, SegmentOptions};
 use crate::skeleton::Skeleton;
@@ -147,9 +147,7 @@ impl Input {
         if motion.frames < 2 {
             bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
         }
-        let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: name.clone() }, ..AnyTopOptions::default() };
-        let section =
-            AnyTopSection::new(&skeleton, &motion.first_frames(2), &options).with_context(|| format!("{name}: cannot build an AnyTop rig"))?;
+        let section = AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig"))?;
         Input::with_record(name, skeleton, motion, section)
     }
 

@@ -21,7 +21,7 @@ use crate::diffusion::Schedule;
 use crate::document::AnyTopSection;
 use crate::motion::Motion;
 use crate::nn::{batch_from, BatchItem, Denoiser};
-use crate::repr::anytop::{AnyTopOptions, AnyTopStats, RestSource};
+use crate::repr::anytop::AnyTopStats;
 use crate::repr::Features;
 use crate::skeleton::Skeleton;
 use crate::synth::SplitMix64;
@@ -137,8 +137,7 @@ pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file
     if motion.frames < 2 {
         bail!("{file}: {} frame(s); DIFT features need a motion of at least 2 frames", motion.frames);
     }
-    let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..AnyTopOptions::default() };
-    let section = AnyTopSection::new(skeleton, &motion.first_frames(2), &options).with_context(|| format!("{file}: cannot build an AnyTop rig"))?;
+    let section = AnyTopSection::of_clip(skeleton, motion, file).with_context(|| format!("{file}: cannot build an AnyTop rig"))?;
     let features = section.rig.encode(skeleton, motion).map_err(|e| anyhow::anyhow!("{file}: {e}"))?.features;
     prepare_encoded(info, skeleton, &section.rest_row, features, file)
 }
