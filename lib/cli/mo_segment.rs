@@ -135,8 +135,6 @@ pub struct Input {
     /// The skeleton and the AnyTop record the features were made with, when known (a BVH
     /// input, or an NPY with --skeleton); a model-based provider needs them.
     pub skeleton: Option<(Skeleton, AnyTopSection)>,
-    /// The motion itself for a BVH input (`None` for an NPY).
-    pub motion: Option<Motion>,
 }
 
 impl Input {
@@ -158,7 +156,7 @@ impl Input {
         }
         let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| anyhow!("{name}: {e}"))?;
         let frame_time = usable_frame_time(motion.frame_time);
-        Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)), motion: Some(motion) })
+        Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)) })
     }
 }
 
@@ -301,7 +299,7 @@ fn load(args: &Args) -> anyhow::Result<Input> {
         }
         None => (None, 1.0 / 30.0),
     };
-    Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton, motion: None })
+    Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton })
 }
 
 /// The JSON report: one key per line, values compact (a per-frame label list stays one line).

@@ -42,10 +42,13 @@ pub fn renamed_shuffled(skeleton: &Skeleton, motion: &Motion, rng: &mut SplitMix
             Joint { name: new.to_string(), parent: j.parent.map(|p| new_of[p]), ..j.clone() }
         })
         .collect();
-    let pick = |values: &[glam::DQuat]| -> Vec<glam::DQuat> { (0..motion.frames).flat_map(|f| order.iter().map(move |&old| values[f * motion.joints + old])).collect() };
-    let translations = (0..motion.frames).flat_map(|f| order.iter().map(move |&old| motion.translations[f * motion.joints + old])).collect();
-    let moved = Motion { rotations: pick(&motion.rotations), translations, ..motion.clone() };
+    let moved = Motion { rotations: reorder(&motion.rotations, motion.joints, &order), translations: reorder(&motion.translations, motion.joints, &order), ..motion.clone() };
     (Skeleton { joints, frame_time: skeleton.frame_time }, moved, order)
+}
+
+/// Per-frame joint values `[frame * joints + joint]` with the joints in `order` (old indices).
+fn reorder<T: Copy>(values: &[T], joints: usize, order: &[usize]) -> Vec<T> {
+    values.chunks_exact(joints.max(1)).flat_map(|frame| order.iter().map(move |&old| frame[old])).collect()
 }
 
 /// For every target joint, the reference joint of the same name (exact), if any.
