@@ -18,6 +18,7 @@ pub mod nn;
 pub mod render;
 pub mod repr;
 pub mod retarget;
+pub mod sata;
 pub mod segment;
 pub mod skeleton;
 pub mod synth;

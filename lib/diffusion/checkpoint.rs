@@ -76,7 +76,8 @@ pub struct CheckpointInfo {
 /// under temporary names first and only then renamed into place, info last, so an
 /// interruption at any point leaves either the previous checkpoint's files or the new ones,
 /// never a partial file (the renames themselves are atomic).
-pub fn save(dir: &Path, info: &CheckpointInfo, varmap: &VarMap, opt: &AdamW) -> anyhow::Result<()> {
+/// Any model's checkpoint (`sata::checkpoint` uses it too): `info` is its `checkpoint.json`.
+pub fn save(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &AdamW) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let tmp = |name: &str| dir.join(format!(".{name}.tmp"));
     let model = tmp("model.safetensors");
@@ -109,7 +110,7 @@ pub fn load(dir: &Path, device: &Device) -> anyhow::Result<Loaded> {
 }
 
 /// The bytes of `dir`'s `checkpoint.json` and `model.safetensors`.
-fn read_dir_files(dir: &Path) -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
+pub fn read_dir_files(dir: &Path) -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
     let path = dir.join("checkpoint.json");
     let info = std::fs::read(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
     let weights = dir.join("model.safetensors");
@@ -133,18 +134,23 @@ pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::
     let varmap = VarMap::new();
     // Build every parameter (the seed does not matter: all are overwritten), then fill them.
     let model = Denoiser::new(seeded_var_builder(&varmap, 0, device), &info.config)?;
-    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
-    {
-        let vars = varmap.data().lock().map_err(|_| anyhow::anyhow!("the parameter map is poisoned"))?;
-        for (name, var) in vars.iter() {
-            let Some(t) = tensors.get(name) else { bail!("model.safetensors: parameter {name} is missing") };
-            if t.dims() != var.dims() {
-                bail!("model.safetensors: parameter {name} is {:?}, the config needs {:?}", t.dims(), var.dims());
-            }
-            var.set(t).with_context(|| format!("model.safetensors: parameter {name}"))?;
-        }
-    }
+    fill_vars(&varmap, weights, device)?;
     Ok(Loaded { info, varmap, model })
+}
+
+/// Overwrite every variable of `varmap` with the tensor of the same name in the safetensors
+/// bytes `weights`; a missing or misshapen one is an error.
+pub fn fill_vars(varmap: &VarMap, weights: &[u8], device: &Device) -> anyhow::Result<()> {
+    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
+    let vars = varmap.data().lock().map_err(|_| anyhow::anyhow!("the parameter map is poisoned"))?;
+    for (name, var) in vars.iter() {
+        let Some(t) = tensors.get(name) else { bail!("model.safetensors: parameter {name} is missing") };
+        if t.dims() != var.dims() {
+            bail!("model.safetensors: parameter {name} is {:?}, the config needs {:?}", t.dims(), var.dims());
+        }
+        var.set(t).with_context(|| format!("model.safetensors: parameter {name}"))?;
+    }
+    Ok(())
 }
 
 /// A model for sampling only: its parameters are plain tensors, not training variables.

@@ -44,7 +44,7 @@ struct Context {
 }
 
 /// `[rows, 3d]` queries, keys and values from one matmul against the stacked weights.
-fn project_qkv(query: &Linear, key: &Linear, value: &Linear, rows: &Tensor) -> candle_core::Result<Tensor> {
+pub(crate) fn project_qkv(query: &Linear, key: &Linear, value: &Linear, rows: &Tensor) -> candle_core::Result<Tensor> {
     let w = Tensor::cat(&[query.weight(), key.weight(), value.weight()], 0)?; // [3d, d]
     let b = Tensor::cat(&[query.bias(), key.bias(), value.bias()], 0)?;
     fused::add_broadcast(&rows.matmul(&w.t()?)?, &b, 1)

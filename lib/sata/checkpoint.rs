@@ -1,0 +1,85 @@
+//! SATA model directories, the same layout as the denoiser's (`diffusion::checkpoint`):
+//! `model.safetensors`, `optimizer.safetensors`, `checkpoint.json` (format `menagerie.sata`),
+//! written atomically, resumable.
+
+use super::train::{FeatureScale, LossWeights};
+use super::{SataConfig, SataModel};
+use crate::diffusion::checkpoint::{fill_vars, read_dir_files};
+use crate::nn::seeded_var_builder;
+use anyhow::{bail, Context};
+use candle_core::Device;
+use candle_nn::VarMap;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+pub const FORMAT: &str = "menagerie.sata";
+pub const VERSION: u32 = 1;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SataInfo {
+    pub format: String,
+    pub version: u32,
+    pub config: SataConfig,
+    pub scale: FeatureScale,
+    pub weights: LossWeights,
+    pub step: u64,
+    pub seed: u64,
+    pub lr: f64,
+    pub batch: usize,
+    pub augment: f64,
+    pub augment_variants: usize,
+    /// Names of the trained skeletons (for the model card and `--verbose`).
+    pub skeletons: Vec<String>,
+}
+
+/// `checkpoint.json`, checked to be a SATA checkpoint of this version. A denoiser directory
+/// gets a message that says so.
+pub fn parse_info(json: &[u8]) -> anyhow::Result<SataInfo> {
+    let value: serde_json::Value = serde_json::from_slice(json).context("checkpoint.json: not JSON")?;
+    let format = value.get("format").and_then(|f| f.as_str()).unwrap_or("");
+    if format != FORMAT {
+        bail!("checkpoint.json: format '{format}', expected '{FORMAT}' (a latent model from `mo-train --arch sata`)");
+    }
+    let info: SataInfo = serde_json::from_value(value).context("checkpoint.json: not a SATA checkpoint description")?;
+    if info.version != VERSION {
+        bail!("checkpoint.json: version {}, expected {VERSION}", info.version);
+    }
+    info.config.validate()?;
+    info.scale.check().map_err(|e| anyhow::anyhow!("checkpoint.json: {e}"))?;
+    Ok(info)
+}
+
+/// A checkpoint with trainable variables (for resuming).
+pub struct Loaded {
+    pub info: SataInfo,
+    pub varmap: VarMap,
+    pub model: SataModel,
+}
+
+pub fn load(dir: &Path, device: &Device) -> anyhow::Result<Loaded> {
+    let (json, weights) = read_dir_files(dir)?;
+    let info = parse_info(&json).with_context(|| format!("model {}", dir.display()))?;
+    let varmap = VarMap::new();
+    let model = SataModel::new(seeded_var_builder(&varmap, 0, device), &info.config)?;
+    fill_vars(&varmap, &weights, device).with_context(|| format!("model {}", dir.display()))?;
+    Ok(Loaded { info, varmap, model })
+}
+
+/// A model for inference only: plain tensors, so no op is recorded for a backward pass.
+pub struct Frozen {
+    pub info: SataInfo,
+    pub model: SataModel,
+}
+
+pub fn frozen_bytes(json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Frozen> {
+    let info = parse_info(json)?;
+    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
+    let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
+    let model = SataModel::new(vb, &info.config).context("model.safetensors does not match checkpoint.json's config")?;
+    Ok(Frozen { info, model })
+}
+
+pub fn frozen(dir: &Path, device: &Device) -> anyhow::Result<Frozen> {
+    let (json, weights) = read_dir_files(dir)?;
+    frozen_bytes(&json, &weights, device).with_context(|| format!("model {}", dir.display()))
+}

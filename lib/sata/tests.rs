@@ -1,0 +1,96 @@
+//! Model-level checks: shapes, topology independence of the latent's size, every parameter
+//! trained, a tiny model learning to reconstruct one clip.
+
+use super::graph::{depths, reverse_depths, SkeletonGraph};
+use super::train::{loss, FeatureScale, LossWeights};
+use super::{SataConfig, SataModel};
+use crate::diffusion::train::named_vars;
+use crate::document::AnyTopSection;
+use crate::embed::NameTable;
+use crate::nn::seeded_var_builder;
+use crate::repr::Features;
+use crate::synth::{self, SplitMix64};
+use candle_core::{Device, Tensor};
+use candle_nn::VarMap;
+
+fn clip(name: &str) -> (crate::skeleton::Skeleton, SkeletonGraph, Features) {
+    let (skeleton, motion) = synth::creature(name, 0).unwrap();
+    let section = AnyTopSection::of_clip(&skeleton, &motion, name).unwrap();
+    let names = NameTable::builtin().unwrap().embed_skeleton(&skeleton);
+    let g = SkeletonGraph::new(&skeleton, &section.rig, &names, &Device::Cpu).unwrap();
+    let features = section.rig.encode(&skeleton, &motion).unwrap().features;
+    (skeleton, g, features)
+}
+
+fn tensor(f: &Features, frames: usize, scale: &FeatureScale) -> Tensor {
+    let mut f = Features { frames, data: f.data[..frames * f.joints * f.dims].to_vec(), ..f.clone() };
+    scale.apply(&mut f);
+    Tensor::from_vec(f.data, (1, frames, f.joints, f.dims), &Device::Cpu).unwrap()
+}
+
+#[test]
+fn depths_of_a_chain_with_a_branch() {
+    let parents = [None, Some(0), Some(1), Some(1), Some(3)];
+    assert_eq!(depths(&parents), vec![0, 1, 2, 2, 3]);
+    assert_eq!(reverse_depths(&parents), vec![3, 2, 0, 1, 0]);
+}
+
+#[test]
+fn latents_have_one_size_for_every_skeleton_and_decode_anywhere() {
+    let varmap = VarMap::new();
+    let model = SataModel::new(seeded_var_builder(&varmap, 3, &Device::Cpu), &SataConfig::tiny()).unwrap();
+    let (_, dog, dog_f) = clip("quadruped");
+    let (_, crab, crab_f) = clip("crab");
+    assert_ne!(dog.joints, crab.joints);
+    let scale = FeatureScale::measure([&dog_f, &crab_f]);
+    let (mu_dog, _) = model.encode(&tensor(&dog_f, 12, &scale), &dog).unwrap();
+    let (mu_crab, _) = model.encode(&tensor(&crab_f, 12, &scale), &crab).unwrap();
+    assert_eq!(mu_dog.dims(), &[1, 12, 16]);
+    assert_eq!(mu_crab.dims(), mu_dog.dims());
+    let on_crab = model.decode(&mu_dog, &crab).unwrap();
+    assert_eq!(on_crab.dims(), &[1, 12, crab.joints, 13]);
+    let v: Vec<f32> = on_crab.flatten_all().unwrap().to_vec1().unwrap();
+    assert!(v.iter().all(|x| x.is_finite()));
+}
+
+#[test]
+fn every_parameter_gets_a_gradient() {
+    let varmap = VarMap::new();
+    let model = SataModel::new(seeded_var_builder(&varmap, 5, &Device::Cpu), &SataConfig::tiny()).unwrap();
+    let (_, g, f) = clip("biped");
+    let scale = FeatureScale::measure([&f]);
+    let x = tensor(&f, 10, &scale);
+    let s = scale.tensor(g.joints, &Device::Cpu).unwrap();
+    let (total, report) = loss(&model, &x, &g, &s, &LossWeights::default(), &mut SplitMix64::new(1)).unwrap();
+    assert!(report.total.is_finite() && report.total > 0.0, "{report:?}");
+    let grads = total.backward().unwrap();
+    let vars = named_vars(&varmap);
+    assert!(vars.len() > 50, "{} parameters", vars.len());
+    for (name, var) in &vars {
+        let g = grads.get(var.as_tensor()).unwrap_or_else(|| panic!("{name}: no gradient"));
+        let norm = g.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap();
+        assert!(norm > 0.0, "{name}: zero gradient");
+    }
+}
+
+#[test]
+fn a_tiny_model_learns_to_reconstruct_one_clip() {
+    let varmap = VarMap::new();
+    let model = SataModel::new(seeded_var_builder(&varmap, 7, &Device::Cpu), &SataConfig::tiny()).unwrap();
+    let (_, g, f) = clip("quadruped");
+    let scale = FeatureScale::measure([&f]);
+    let x = tensor(&f, 16, &scale);
+    let s = scale.tensor(g.joints, &Device::Cpu).unwrap();
+    let vars = named_vars(&varmap);
+    let mut opt = crate::diffusion::train::AdamW::new(3e-3);
+    let mut rng = SplitMix64::new(2);
+    let weights = LossWeights::default();
+    let first = loss(&model, &x, &g, &s, &weights, &mut rng).unwrap().1.reconstruction;
+    let mut last = first;
+    for _ in 0..60 {
+        let (total, report) = loss(&model, &x, &g, &s, &weights, &mut rng).unwrap();
+        opt.update(&vars, &total.backward().unwrap()).unwrap();
+        last = report.reconstruction;
+    }
+    assert!(last < first * 0.5, "reconstruction MSE {first} -> {last}");
+}

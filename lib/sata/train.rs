@@ -1,0 +1,228 @@
+//! Training SATA (paper §3.4): L = L_rec + λ_KL · KL, with L_rec after SAME: reconstruction of
+//! the features (positions, 6D rotations, velocities, contacts), the geodesic rotation angle,
+//! smoothness (frame-to-frame changes match), foot contact (feet that touch the ground in the
+//! data do not slide in the output) and ground penetration (no joint below the floor).
+//!
+//! Batches are bucketed by skeleton: a step draws one skeleton as AnyTop's balancing sampler
+//! does (every skeleton equally likely, an augmented variant with the set's probability), then
+//! `batch` crops of its clips. Features come from `diffusion::data::TrainSet` (AnyTop's
+//! representation, augmentation and grouping), de-normalised and divided by a global
+//! [`FeatureScale`] instead of per-skeleton statistics (see the module doc of `sata`).
+
+use super::graph::SkeletonGraph;
+use super::{SataModel, FEATURE_DIMS};
+use crate::diffusion::data::{Crop, TrainSet};
+use crate::diffusion::train::{gaussian, rotation_distance, AdamW};
+use crate::repr::Features;
+use crate::synth::SplitMix64;
+use candle_core::{Device, Tensor, Var};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Feature groups of AnyTop's 13 dims: position, 6D rotation, velocity, contact.
+const GROUPS: [(usize, usize); 4] = [(0, 3), (3, 9), (9, 12), (12, 13)];
+
+/// One divisor per feature dim, for the root token and for the other joints: the root-mean-
+/// square of the dim's group over the training set (contacts stay 0/1). Dividing (no mean
+/// shift) keeps zero velocity at zero, and the same numbers serve every skeleton.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FeatureScale {
+    pub root: Vec<f32>,
+    pub joint: Vec<f32>,
+}
+
+impl FeatureScale {
+    /// From raw (not normalised) AnyTop features of many skeletons.
+    pub fn measure<'a>(clips: impl IntoIterator<Item = &'a Features>) -> FeatureScale {
+        let mut sums = [[0f64; 4]; 2];
+        let mut counts = [[0f64; 4]; 2];
+        for c in clips {
+            for (k, row) in c.data.chunks_exact(FEATURE_DIMS).enumerate() {
+                let side = usize::from(k % c.joints.max(1) != 0);
+                for (g, &(a, b)) in GROUPS.iter().enumerate() {
+                    sums[side][g] += row[a..b].iter().map(|&v| (v as f64) * (v as f64)).sum::<f64>();
+                    counts[side][g] += (b - a) as f64;
+                }
+            }
+        }
+        let expand = |side: usize| -> Vec<f32> {
+            let mut out = vec![1f32; FEATURE_DIMS];
+            for (g, &(a, b)) in GROUPS.iter().enumerate().take(3) {
+                let rms = if counts[side][g] > 0.0 { (sums[side][g] / counts[side][g]).sqrt() } else { 1.0 };
+                let rms = if rms.is_finite() && rms > 1e-6 { rms } else { 1.0 };
+                out[a..b].iter_mut().for_each(|v| *v = rms as f32);
+            }
+            out
+        };
+        FeatureScale { root: expand(0), joint: expand(1) }
+    }
+
+    pub fn check(&self) -> Result<(), String> {
+        for (what, v) in [("root", &self.root), ("joint", &self.joint)] {
+            if v.len() != FEATURE_DIMS || v.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+                return Err(format!("feature scale ({what}): expected {FEATURE_DIMS} positive numbers, got {v:?}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// `[1, 1, J, 13]` divisors for a skeleton of `joints` joints.
+    pub fn tensor(&self, joints: usize, device: &Device) -> candle_core::Result<Tensor> {
+        let mut v = Vec::with_capacity(joints * FEATURE_DIMS);
+        for j in 0..joints {
+            v.extend_from_slice(if j == 0 { &self.root } else { &self.joint });
+        }
+        Tensor::from_vec(v, (1, 1, joints, FEATURE_DIMS), device)
+    }
+
+    /// Divide raw features in place.
+    pub fn apply(&self, f: &mut Features) {
+        let joints = f.joints.max(1);
+        for (k, row) in f.data.chunks_exact_mut(FEATURE_DIMS).enumerate() {
+            let s = if k % joints == 0 { &self.root } else { &self.joint };
+            row.iter_mut().zip(s).for_each(|(v, s)| *v /= s);
+        }
+    }
+
+    /// Multiply scaled features back in place.
+    pub fn undo(&self, f: &mut Features) {
+        let joints = f.joints.max(1);
+        for (k, row) in f.data.chunks_exact_mut(FEATURE_DIMS).enumerate() {
+            let s = if k % joints == 0 { &self.root } else { &self.joint };
+            row.iter_mut().zip(s).for_each(|(v, s)| *v *= s);
+        }
+    }
+}
+
+/// Raw features of every clip of every skeleton (and variant) in the set.
+pub fn raw_clips(set: &TrainSet) -> Vec<Features> {
+    let all = set.skeletons.iter().chain(set.augmented.iter().flatten());
+    all.flat_map(|sk| {
+        sk.clips.iter().map(move |c| {
+            let mut f = c.clone();
+            // Statistics were computed from these very clips: shapes match.
+            let _ = sk.stats.denormalise(&mut f);
+            f
+        })
+    })
+    .collect()
+}
+
+/// Loss weights (λ of §3.4); the defaults weigh each term about equally at the start.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LossWeights {
+    pub geodesic: f64,
+    pub smooth: f64,
+    pub contact: f64,
+    pub penetration: f64,
+    pub kl: f64,
+}
+
+impl Default for LossWeights {
+    fn default() -> LossWeights {
+        LossWeights { geodesic: 1.0, smooth: 1.0, contact: 0.1, penetration: 1.0, kl: 1e-4 }
+    }
+}
+
+/// Loss terms of one step (means, before weighting).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SataLosses {
+    pub total: f64,
+    pub reconstruction: f64,
+    pub geodesic: f64,
+    pub smooth: f64,
+    pub contact: f64,
+    pub penetration: f64,
+    pub kl: f64,
+}
+
+/// Crops of one skeleton (or variant) for a batch, all of one length: the balancing sampler's
+/// draw for the first, then clips of the same skeleton.
+pub fn draw_crops(set: &TrainSet, rng: &mut SplitMix64, batch: usize, frames: usize) -> Vec<Crop> {
+    let Some(first) = set.sample(rng, 1, frames).pop() else { return Vec::new() };
+    let sk = set.data(&first);
+    let mut clips = vec![first.clip];
+    clips.extend((1..batch).map(|_| rng.below(sk.clips.len())));
+    let len = clips.iter().map(|&c| sk.clips[c].frames).min().unwrap_or(0).min(frames);
+    clips.into_iter().map(|c| Crop { clip: c, start: rng.below(sk.clips[c].frames - len + 1), frames: len, ..first }).collect()
+}
+
+/// Scaled features `[B, T, J, 13]` of same-skeleton crops.
+pub fn batch_tensor(set: &TrainSet, crops: &[Crop], scale: &FeatureScale, device: &Device) -> anyhow::Result<Tensor> {
+    let first = crops.first().ok_or_else(|| anyhow::anyhow!("empty batch"))?;
+    let sk = set.data(first);
+    let mut data = Vec::new();
+    for c in crops {
+        let mut f = set.crop(c);
+        sk.stats.denormalise(&mut f)?;
+        scale.apply(&mut f);
+        data.extend_from_slice(&f.data);
+    }
+    Ok(Tensor::from_vec(data, (crops.len(), first.frames, sk.skeleton.len(), FEATURE_DIMS), device)?)
+}
+
+/// The loss of reconstructing `x` (scaled, `[B, T, J, 13]`) through the model, with the VAE's
+/// sampled latent (noise from `rng`).
+pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> anyhow::Result<(Tensor, SataLosses)> {
+    let (mu, logvar) = model.encode(x, g)?;
+    let eps = Tensor::from_vec(gaussian(rng, mu.elem_count()), mu.shape(), mu.device())?;
+    let z = (&mu + (logvar.clone() * 0.5)?.exp()?.mul(&eps)?)?;
+    let y = model.decode(&z, g)?;
+    let (_, t, j, _) = x.dims4()?;
+    let rec = (&y - x)?.sqr()?.mean_all()?;
+    // Rotations compared as rotations, in their own units.
+    let rot = |v: &Tensor| -> candle_core::Result<Tensor> { v.broadcast_mul(scale)?.narrow(3, 3, 6) };
+    let geo = rotation_distance(&rot(&y)?, &rot(x)?)?.mean_all()?;
+    let smooth = if t > 1 {
+        let diff = |v: &Tensor| -> candle_core::Result<Tensor> { v.narrow(1, 1, t - 1)? - v.narrow(1, 0, t - 1)? };
+        (diff(&y)? - diff(x)?)?.sqr()?.mean_all()?
+    } else {
+        rec.zeros_like()?
+    };
+    // Feet in contact in the data: the output's velocity there should be zero.
+    let contact = x.narrow(3, 12, 1)?.broadcast_mul(&y.narrow(3, 9, 3)?.sqr()?)?.mean_all()?;
+    // Heights of the non-root joints (dim 1 is absolute height) below the floor.
+    let penetration = if j > 1 { y.narrow(2, 1, j - 1)?.narrow(3, 1, 1)?.neg()?.relu()?.mean_all()? } else { rec.zeros_like()? };
+    let kl = ((mu.sqr()? + logvar.exp()?)? - 1.0)?.sub(&logvar)?.mean_all()?.affine(0.5, 0.0)?;
+    let total = (((((&rec + (&geo * weights.geodesic)?)? + (&smooth * weights.smooth)?)? + (&contact * weights.contact)?)? + (&penetration * weights.penetration)?)?
+        + (&kl * weights.kl)?)?;
+    let v = |t: &Tensor| -> candle_core::Result<f64> { Ok(t.to_scalar::<f32>()? as f64) };
+    let report = SataLosses {
+        total: v(&total)?,
+        reconstruction: v(&rec)?,
+        geodesic: v(&geo)?,
+        smooth: v(&smooth)?,
+        contact: v(&contact)?,
+        penetration: v(&penetration)?,
+        kl: v(&kl)?,
+    };
+    Ok((total, report))
+}
+
+/// One training step: draw, loss, backward, AdamW.
+#[allow(clippy::too_many_arguments)]
+pub fn train_step(
+    model: &SataModel,
+    vars: &BTreeMap<String, Var>,
+    opt: &mut AdamW,
+    set: &TrainSet,
+    scale: &FeatureScale,
+    weights: &LossWeights,
+    rng: &mut SplitMix64,
+    batch: usize,
+    device: &Device,
+) -> anyhow::Result<SataLosses> {
+    let crops = draw_crops(set, rng, batch, model.config().window);
+    let first = crops.first().ok_or_else(|| anyhow::anyhow!("the training set gave no crop"))?;
+    let sk = set.data(first);
+    let g = SkeletonGraph::new(&sk.skeleton, &sk.section.rig, &sk.names, device)?;
+    let x = batch_tensor(set, &crops, scale, device)?;
+    let scale_t = scale.tensor(sk.skeleton.len(), device)?;
+    let (total, report) = loss(model, &x, &g, &scale_t, weights, rng)?;
+    if !report.total.is_finite() {
+        anyhow::bail!("the loss is not finite ({report:?}) at skeleton {}", sk.name);
+    }
+    let grads = total.backward()?;
+    opt.update(vars, &grads)?;
+    Ok(report)
+}
