@@ -8,6 +8,7 @@ use crate::diffusion::train::{named_vars, train_step, AdamW};
 use crate::diffusion::Schedule;
 use crate::embed::NameTable;
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig};
+use crate::sata::{self, checkpoint::SataInfo, train::{FeatureScale, LossWeights}, SataConfig, SataModel};
 use crate::skeleton::topology;
 use crate::synth::SplitMix64;
 use anyhow::{bail, Context};
@@ -73,9 +74,18 @@ pub struct Args {
     /// Crops per step.
     #[arg(long, value_name = "N", default_value_t = 16, value_parser = clap::value_parser!(u64).range(1..=1024))]
     pub batch: u64,
-    /// Crop length in frames.
-    #[arg(long, value_name = "FRAMES", default_value_t = 40, value_parser = clap::value_parser!(u64).range(2..=1000))]
-    pub crop: u64,
+    /// Crop length in frames (default 40 for anytop; for sata the preset's window, 32 for
+    /// small, which then is also the model's inference window).
+    #[arg(long, value_name = "FRAMES", value_parser = clap::value_parser!(u64).range(2..=1000))]
+    pub crop: Option<u64>,
+    /// What to train: anytop (the diffusion model behind mo-sample, mo-dift and mo-segment) or
+    /// sata (the topology-agnostic autoencoder behind mo-encode --latent and mo-retarget
+    /// --method latent).
+    #[arg(long, value_enum, default_value_t = Arch::Anytop)]
+    pub arch: Arch,
+    /// sata: weight of the KL term that keeps the latent near a unit Gaussian.
+    #[arg(long, value_name = "W", default_value_t = 1e-4)]
+    pub lambda_kl: f64,
     /// Learning rate.
     #[arg(long, value_name = "LR", default_value_t = 1e-4)]
     pub lr: f64,
@@ -117,6 +127,12 @@ fn parse_probability(text: &str) -> Result<f64, String> {
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arch {
+    Anytop,
+    Sata,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
     Tiny,
     Small,
@@ -129,6 +145,14 @@ impl Preset {
             Preset::Tiny => DenoiserConfig::tiny(),
             Preset::Small => DenoiserConfig::small(),
             Preset::Paper => DenoiserConfig::paper(),
+        }
+    }
+
+    fn sata(self) -> SataConfig {
+        match self {
+            Preset::Tiny => SataConfig::tiny(),
+            Preset::Small => SataConfig::small(),
+            Preset::Paper => SataConfig::paper(),
         }
     }
 }
@@ -176,9 +200,10 @@ fn catch_interrupts() -> anyhow::Result<()> {
     installed.clone().map_err(|e| anyhow::anyhow!("cannot catch Ctrl-C: {e}"))
 }
 
-fn save(dir: &std::path::Path, info: &CheckpointInfo, varmap: &VarMap, opt: &AdamW) -> anyhow::Result<()> {
+/// Run a checkpoint save with `SAVING` set, so a second Ctrl-C waits for it.
+fn save_guarded(save: impl FnOnce() -> anyhow::Result<()>) -> anyhow::Result<()> {
     SAVING.store(true, Ordering::SeqCst);
-    let result = checkpoint::save(dir, info, varmap, opt);
+    let result = save();
     SAVING.store(false, Ordering::SeqCst);
     result
 }
@@ -213,16 +238,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             eprintln!("mo-train: {msg}");
         }
     };
+    if args.arch == Arch::Sata {
+        return run_sata(args);
+    }
+    let crop = args.crop.unwrap_or(40);
     let device = Device::Cpu;
     let schedule = Schedule::cosine(100);
     let dmax = topology::DEFAULT_DMAX;
     // The checkpoint first: a resumed run must rebuild the data (augmented variants included)
     // from the seed the run started with.
-    let (varmap, model, mut opt, mut info) = if args.resume {
+    let (varmap, model, opt, mut info) = if args.resume {
         let loaded = checkpoint::load(&args.out, &device)?;
-        let opt = checkpoint::load_optimizer(&args.out, &loaded.info, &device, args.lr)?;
+        let opt = checkpoint::load_optimizer(&args.out, loaded.info.step, &device, args.lr)?;
         let i = &loaded.info;
-        if i.batch as u64 != args.batch || i.crop as u64 != args.crop || i.seed != args.common.seed || i.augment != args.augment || i.augment_variants as u64 != args.augment_variants {
+        if i.batch as u64 != args.batch || i.crop as u64 != crop || i.seed != args.common.seed || i.augment != args.augment || i.augment_variants as u64 != args.augment_variants {
             say("note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been".into());
         }
         (loaded.varmap, loaded.model, opt, loaded.info)
@@ -242,7 +271,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             schedule_steps: schedule.len(),
             lr: args.lr,
             batch: args.batch as usize,
-            crop: args.crop as usize,
+            crop: crop as usize,
             dmax,
             augment: 0.0,
             augment_variants: 0,
@@ -253,12 +282,130 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     info.augment = args.augment;
     info.augment_variants = args.augment_variants as usize;
 
+    let set = training_set(args, info.seed, info.dmax)?;
+    info.skeletons = set
+        .skeletons
+        .iter()
+        .map(|s| TrainedSkeleton {
+            name: s.name.clone(),
+            joints: s.skeleton.joints.iter().map(|j| j.name.clone()).collect(),
+            parents: s.skeleton.parents(),
+            stats: s.stats.clone(),
+            clips: s.clips.len(),
+            offsets: s.skeleton.joints.iter().map(|j| j.offset.to_array()).collect(),
+        })
+        .collect();
+    let first = info.step;
+    let vars = named_vars(&varmap);
+    let mut trainer = AnyTopTrainer { args, info, varmap, model, vars, opt, set, schedule, crop: crop as usize, device };
+    train_loop(args, first, &mut trainer)
+}
+
+/// The data stream of step k depends only on the seed and k, so a resumed run draws what the
+/// uninterrupted one would have.
+fn step_rng(seed: u64, k: u64) -> SplitMix64 {
+    SplitMix64::new(seed ^ k.wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
+/// What the training loop drives, for either architecture.
+trait Trainer {
+    /// Step `k` (0-based): the loss, and extra `"name":value` pairs for the JSON log.
+    fn step(&mut self, k: u64) -> anyhow::Result<(f64, String)>;
+    /// Save a checkpoint saying `steps` steps are done.
+    fn save(&mut self, steps: u64) -> anyhow::Result<()>;
+}
+
+/// Steps from `first` to `--steps` with the log, progress, periodic checkpoints and Ctrl-C.
+fn train_loop(args: &Args, first: u64, trainer: &mut impl Trainer) -> anyhow::Result<()> {
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut log = std::fs::OpenOptions::new().create(true).append(true).open(args.out.join("log.jsonl")).context("cannot open the training log")?;
+    catch_interrupts()?;
+    let started = Instant::now();
+    let mut last_save = Instant::now();
+    let mut last_draw: Option<Instant> = None;
+    let every = Duration::from_secs_f64(args.checkpoint_minutes.max(0.0) * 60.0);
+    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr()) && !args.common.quiet;
+    let mut step = first;
+    while step < args.steps {
+        if STOP.load(Ordering::SeqCst) {
+            if terminal {
+                eprintln!();
+            }
+            save_guarded(|| trainer.save(step))?;
+            return Err(Interrupted { step }.into());
+        }
+        let (loss, extra) = trainer.step(step)?;
+        step += 1;
+        let done = step - first;
+        let rate = done as f64 / started.elapsed().as_secs_f64().max(1e-9);
+        let eta = (args.steps - step) as f64 / rate.max(1e-9);
+        writeln!(log, "{{\"step\":{step},\"loss\":{loss}{extra},\"steps_per_second\":{rate:.4},\"elapsed\":{:.2}}}", started.elapsed().as_secs_f64())
+            .context("cannot write the training log")?;
+        if terminal {
+            // Redraw at most ten times a second: fast tiny models would flood the terminal.
+            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || step == args.steps {
+                let width = args.steps.to_string().len();
+                eprint!("\rmo-train: {} {step:>width$}/{}  loss {loss:.4}  {rate:.2} steps/s  ETA {}   ", bar(step, args.steps, 30), args.steps, duration(eta));
+                last_draw = Some(Instant::now());
+            }
+        } else if !args.common.quiet && (step % 50 == 0 || step == args.steps) {
+            eprintln!("mo-train: step {step}/{}  loss {loss:.4}  {rate:.2} steps/s  ETA {}", args.steps, duration(eta));
+        }
+        if last_save.elapsed() >= every {
+            save_guarded(|| trainer.save(step))?;
+            last_save = Instant::now();
+        }
+    }
+    if terminal {
+        eprintln!();
+    }
+    save_guarded(|| trainer.save(step))?;
+    if !args.common.quiet {
+        eprintln!("mo-train: saved step {step} to {}", args.out.display());
+    }
+    Ok(())
+}
+
+/// The denoiser's training state.
+struct AnyTopTrainer<'a> {
+    args: &'a Args,
+    info: CheckpointInfo,
+    varmap: VarMap,
+    model: Denoiser,
+    vars: std::collections::BTreeMap<String, candle_core::Var>,
+    opt: AdamW,
+    set: TrainSet,
+    schedule: Schedule,
+    crop: usize,
+    device: Device,
+}
+
+impl Trainer for AnyTopTrainer<'_> {
+    fn step(&mut self, k: u64) -> anyhow::Result<(f64, String)> {
+        let mut rng = step_rng(self.info.seed, k);
+        let stats = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.schedule, &mut rng, self.args.batch as usize, self.crop, self.args.lambda_geo, &self.device)?;
+        Ok((stats.loss, String::new()))
+    }
+
+    fn save(&mut self, steps: u64) -> anyhow::Result<()> {
+        self.info.step = steps;
+        checkpoint::save(&self.args.out, &self.info, &self.varmap, &self.opt)
+    }
+}
+
+/// The clips of DATA grouped by skeleton, with augmented variants, as both architectures use.
+fn training_set(args: &Args, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
+    let say = |msg: String| {
+        if !args.common.quiet {
+            eprintln!("mo-train: {msg}");
+        }
+    };
     let files = expand_inputs(&args.data)?;
     let loaded = load_motions(&files, &LoadOptions::default())?;
     let clips: Vec<RawClip> = loaded.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
     let names = NameTable::builtin().context("the built-in joint-name table")?;
-    let augmentation = Augmentation { probability: args.augment, variants: args.augment_variants as usize, seed: info.seed };
-    let (set, dropped) = TrainSet::build(clips, names, info.dmax, &augmentation)?;
+    let augmentation = Augmentation { probability: args.augment, variants: args.augment_variants as usize, seed };
+    let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;
     for d in &dropped {
         say(format!("{d}: too short to crop, left out"));
     }
@@ -278,74 +425,83 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             say(format!("variant {}: {} joints, {} clips", v.name, v.skeleton.len(), v.clips.len()));
         }
     }
-    info.skeletons = set
-        .skeletons
-        .iter()
-        .map(|s| TrainedSkeleton {
-            name: s.name.clone(),
-            joints: s.skeleton.joints.iter().map(|j| j.name.clone()).collect(),
-            parents: s.skeleton.parents(),
-            stats: s.stats.clone(),
-            clips: s.clips.len(),
-            offsets: s.skeleton.joints.iter().map(|j| j.offset.to_array()).collect(),
-        })
-        .collect();
-    let vars = named_vars(&varmap);
-    // The data stream of step k depends only on the seed and k, so a resumed run draws what
-    // the uninterrupted one would have.
-    let step_rng = |k: u64| SplitMix64::new(info.seed ^ k.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let mut log = std::fs::OpenOptions::new().create(true).append(true).open(args.out.join("log.jsonl")).context("cannot open the training log")?;
-    catch_interrupts()?;
-    let started = Instant::now();
-    let mut last_save = Instant::now();
-    let mut last_draw: Option<Instant> = None;
+    Ok(set)
+}
+
+/// `mo-train --arch sata`: the autoencoder on the same data, bucketed by skeleton.
+fn run_sata(args: &Args) -> anyhow::Result<()> {
+    let device = Device::Cpu;
+    let (varmap, model, opt, mut info, set) = if args.resume {
+        let loaded = sata::checkpoint::load(&args.out, &device)?;
+        let opt = checkpoint::load_optimizer(&args.out, loaded.info.step, &device, args.lr)?;
+        let i = &loaded.info;
+        if i.batch as u64 != args.batch || i.seed != args.common.seed || i.augment != args.augment || i.augment_variants as u64 != args.augment_variants {
+            eprintln!("mo-train: note: --batch, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
+        }
+        let set = training_set(args, loaded.info.seed, topology::DEFAULT_DMAX)?;
+        (loaded.varmap, loaded.model, opt, loaded.info, set)
+    } else {
+        if args.out.join("checkpoint.json").exists() {
+            bail!("{} already holds a checkpoint: --resume to continue it, or choose another --out", args.out.display());
+        }
+        let mut cfg = args.preset.sata();
+        if let Some(crop) = args.crop {
+            cfg.window = crop as usize;
+            cfg.overlap = cfg.overlap.min(cfg.window.saturating_sub(1) / 2);
+        }
+        cfg.validate()?;
+        let set = training_set(args, args.common.seed, topology::DEFAULT_DMAX)?;
+        // Measured once on the original data; a resumed run keeps the checkpoint's.
+        let scale = FeatureScale::measure(&sata::train::raw_clips(&set));
+        let varmap = VarMap::new();
+        let model = SataModel::new(seeded_var_builder(&varmap, args.common.seed, &device), &cfg)?;
+        let info = SataInfo {
+            format: sata::checkpoint::FORMAT.into(),
+            version: sata::checkpoint::VERSION,
+            config: cfg,
+            scale,
+            weights: LossWeights { kl: args.lambda_kl, ..LossWeights::default() },
+            step: 0,
+            seed: args.common.seed,
+            lr: args.lr,
+            batch: args.batch as usize,
+            augment: args.augment,
+            augment_variants: args.augment_variants as usize,
+            skeletons: Vec::new(),
+        };
+        (varmap, model, AdamW::new(args.lr), info, set)
+    };
+    info.skeletons = set.skeletons.iter().map(|s| s.name.clone()).collect();
     let first = info.step;
-    let every = Duration::from_secs_f64(args.checkpoint_minutes.max(0.0) * 60.0);
-    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr()) && !args.common.quiet;
-    while info.step < args.steps {
-        if STOP.load(Ordering::SeqCst) {
-            if terminal {
-                eprintln!();
-            }
-            save(&args.out, &info, &varmap, &opt)?;
-            return Err(Interrupted { step: info.step }.into());
-        }
-        let mut rng = step_rng(info.step);
-        let stats = train_step(&model, &vars, &mut opt, &set, &schedule, &mut rng, args.batch as usize, args.crop as usize, args.lambda_geo, &device)?;
-        info.step += 1;
-        let done = info.step - first;
-        let rate = done as f64 / started.elapsed().as_secs_f64().max(1e-9);
-        let eta = (args.steps - info.step) as f64 / rate.max(1e-9);
-        writeln!(log, "{{\"step\":{},\"loss\":{},\"steps_per_second\":{:.4},\"elapsed\":{:.2}}}", info.step, stats.loss, rate, started.elapsed().as_secs_f64())
-            .context("cannot write the training log")?;
-        if terminal {
-            // Redraw at most ten times a second: fast tiny models would flood the terminal.
-            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || info.step == args.steps {
-                let width = args.steps.to_string().len();
-                eprint!(
-                    "\rmo-train: {} {:>width$}/{}  loss {:.4}  {:.2} steps/s  ETA {}   ",
-                    bar(info.step, args.steps, 30),
-                    info.step,
-                    args.steps,
-                    stats.loss,
-                    rate,
-                    duration(eta)
-                );
-                last_draw = Some(Instant::now());
-            }
-        } else if !args.common.quiet && (info.step % 50 == 0 || info.step == args.steps) {
-            eprintln!("mo-train: step {}/{}  loss {:.4}  {:.2} steps/s  ETA {}", info.step, args.steps, stats.loss, rate, duration(eta));
-        }
-        if last_save.elapsed() >= every {
-            save(&args.out, &info, &varmap, &opt)?;
-            last_save = Instant::now();
-        }
+    let vars = named_vars(&varmap);
+    let mut trainer = SataTrainer { args, info, varmap, model, vars, opt, set, device };
+    train_loop(args, first, &mut trainer)
+}
+
+struct SataTrainer<'a> {
+    args: &'a Args,
+    info: SataInfo,
+    varmap: VarMap,
+    model: SataModel,
+    vars: std::collections::BTreeMap<String, candle_core::Var>,
+    opt: AdamW,
+    set: TrainSet,
+    device: Device,
+}
+
+impl Trainer for SataTrainer<'_> {
+    fn step(&mut self, k: u64) -> anyhow::Result<(f64, String)> {
+        let mut rng = step_rng(self.info.seed, k);
+        let l = sata::train::train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.info.scale, &self.info.weights, &mut rng, self.args.batch as usize, &self.device)?;
+        let extra = format!(
+            ",\"reconstruction\":{},\"geodesic\":{},\"smooth\":{},\"contact\":{},\"penetration\":{},\"kl\":{}",
+            l.reconstruction, l.geodesic, l.smooth, l.contact, l.penetration, l.kl
+        );
+        Ok((l.total, extra))
     }
-    if terminal {
-        eprintln!();
+
+    fn save(&mut self, steps: u64) -> anyhow::Result<()> {
+        self.info.step = steps;
+        checkpoint::save(&self.args.out, &self.info, &self.varmap, &self.opt)
     }
-    save(&args.out, &info, &varmap, &opt)?;
-    say(format!("saved step {} to {}", info.step, args.out.display()));
-    Ok(())
 }

@@ -187,11 +187,11 @@ pub fn frozen_default(device: &Device) -> anyhow::Result<Frozen> {
 }
 
 /// The optimiser state saved beside a checkpoint.
-pub fn load_optimizer(dir: &Path, info: &CheckpointInfo, device: &Device, lr: f64) -> anyhow::Result<AdamW> {
+pub fn load_optimizer(dir: &Path, step: u64, device: &Device, lr: f64) -> anyhow::Result<AdamW> {
     let path = dir.join("optimizer.safetensors");
     let tensors = candle_core::safetensors::load(&path, device).with_context(|| format!("cannot load {}", path.display()))?;
     let mut opt = AdamW::new(lr);
-    opt.load_state(&tensors, info.step);
+    opt.load_state(&tensors, step);
     Ok(opt)
 }
 
