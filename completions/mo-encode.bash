@@ -23,7 +23,7 @@ _mo__encode() {
 
     case "${cmd}" in
         mo__encode)
-            opts="-o -q -v -h -V --repr --decode --skeleton --rest-pose --face-joints --body-axis --feet --require-contacts --normalise --stats --emit-skeleton --placement --from --normalised --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --repr --decode --skeleton --rest-pose --face-joints --body-axis --feet --require-contacts --normalise --stats --emit-skeleton --placement --from --normalised --latent --decode-latent --model --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -67,6 +67,10 @@ _mo__encode() {
                     ;;
                 --from)
                     COMPREPLY=($(compgen -W "rotations positions" -- "${cur}"))
+                    return 0
+                    ;;
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --output)

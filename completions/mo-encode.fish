@@ -10,6 +10,7 @@ complete -c mo-encode -l emit-skeleton -d 'anytop: write the skeleton document w
 complete -c mo-encode -l placement -d 'anytop: where each clip stood (JSON): written when encoding, read when decoding' -r -F
 complete -c mo-encode -l from -d 'anytop decoding: from the rotations (default; exact for encoded features) or the positions' -r -f -a "rotations\t'The features\' 6D rotations: exact for encoded features'
 positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
+complete -c mo-encode -l model -d 'The latent model: a directory from \'mo-train --arch sata\' [default: the built-in one]' -r -F
 complete -c mo-encode -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-encode -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-encode -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
@@ -17,6 +18,8 @@ complete -c mo-encode -l decode -d 'Decode an NPY of features back to BVH on --s
 complete -c mo-encode -l require-contacts -d 'anytop: fail when the skeleton has no foot joints, instead of writing all-zero contact features with a warning (for training data of walkers, where a missed foot is a bug)'
 complete -c mo-encode -l normalise -d 'anytop: write normalised features, (x - mean) / (std + 1e-6)'
 complete -c mo-encode -l normalised -d 'anytop decoding: the NPY holds normalised features; undo it with --skeleton\'s statistics'
+complete -c mo-encode -l latent -d 'Encode one BVH clip into per-frame latents of the latent model (SATA): NPY [frames - 1, latent], the same size for every skeleton'
+complete -c mo-encode -l decode-latent -d 'Decode latents (NPY [frames, latent] from --latent) onto --skeleton, any skeleton, as BVH'
 complete -c mo-encode -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-encode -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-encode -s h -l help -d 'Print help (see more with \'--help\')'

@@ -23,13 +23,25 @@ _mo__retarget() {
 
     case "${cmd}" in
         mo__retarget)
-            opts="-n -o -q -v -h -V --bind --bind-rate --emit-binding --samples --frames --seconds --key-frames --format --patch --alpha --steps --pyramid --repr --bound-rotation --root-motion --copy-bound --report --output --seed --quiet --verbose --threads --help --version"
+            opts="-n -o -q -v -h -V --bind --method --to --model --bind-rate --emit-binding --samples --frames --seconds --key-frames --format --patch --alpha --steps --pyramid --repr --bound-rotation --root-motion --copy-bound --report --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
                 --bind)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --method)
+                    COMPREPLY=($(compgen -W "m2m latent" -- "${cur}"))
+                    return 0
+                    ;;
+                --to)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --model)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -1,4 +1,8 @@
-complete -c mo-retarget -l bind -d 'Binding JSON file, or \'auto\'' -r
+complete -c mo-retarget -l bind -d 'm2m: binding JSON file, or \'auto\' (required)' -r
+complete -c mo-retarget -l method -d 'How to transfer: m2m (Motion2Motion, from example clips and a sparse binding) or latent (zero-shot through the SATA latent model: no examples, no binding)' -r -f -a "m2m\t''
+latent\t''"
+complete -c mo-retarget -l to -d 'latent: the target skeleton, a BVH or a skeleton document (instead of TARGETS)' -r -F
+complete -c mo-retarget -l model -d 'latent: the model directory from \'mo-train --arch sata\' [default: the built-in one]' -r -F
 complete -c mo-retarget -l bind-rate -d 'Binding rate of --bind auto: 2 x pairs / (source joints + target joints)' -r
 complete -c mo-retarget -s n -l samples -d 'Number of diverse samples' -r
 complete -c mo-retarget -l frames -d 'Output length in frames [default: the source\'s, after resampling]' -r

@@ -50,7 +50,9 @@ EXAMPLES:
     skel-info examples/data/snake.bvh | mo-encode --skeleton - examples/data/snake.bvh > snake.npy
     mo-encode --repr m2m examples/data/bird.bvh examples/data/bird.bvh -o birds.npy
     mo-encode --repr m2m --decode --skeleton examples/data/bird.bvh birds.npy -o bird_{i}.bvh
-    cat examples/data/fish.bvh | mo-encode - --threads 1 > fish.npy";
+    cat examples/data/fish.bvh | mo-encode - --threads 1 > fish.npy
+    mo-encode --latent examples/data/quadruped.bvh -o z.npy
+    mo-encode --decode-latent --skeleton examples/data/dragon.bvh z.npy -o dragon_from_dog.bvh";
 
 /// Encode BVH motion as feature tensors (NPY), or decode tensors back to BVH.
 ///
@@ -92,6 +94,13 @@ EXAMPLES:
 /// positions by inverse kinematics (for generated features); without --placement a clip starts
 /// where the rest pose stands, facing its way. A 4-D batch writes one BVH per sample: give -o
 /// a pattern with {i}, replaced by the sample index.
+///
+/// Latents (--latent, --decode-latent; the SATA autoencoder, --model or the built-in one): a
+/// clip of any skeleton becomes one vector per frame, [frames - 1, latent], whose size does not
+/// depend on the skeleton; --decode-latent puts such a sequence on any --skeleton (a BVH, whose
+/// first frame is taken as its rest pose, or a skeleton document), zero-shot: the decoded
+/// motion starts where the target's rest pose stands, at its BVH's frame time (1/30 s for a
+/// document). Long clips go through the model in overlapping windows.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-encode", version, after_long_help = EXAMPLES)]
 pub struct Args {
@@ -171,6 +180,17 @@ pub struct Args {
     /// anytop decoding: the NPY holds normalised features; undo it with --skeleton's statistics.
     #[arg(long, requires = "decode")]
     pub normalised: bool,
+    /// Encode one BVH clip into per-frame latents of the latent model (SATA): NPY [frames - 1,
+    /// latent], the same size for every skeleton.
+    #[arg(long, conflicts_with_all = ["decode", "decode_latent", "repr"])]
+    pub latent: bool,
+    /// Decode latents (NPY [frames, latent] from --latent) onto --skeleton, any skeleton, as
+    /// BVH.
+    #[arg(long, requires = "skeleton", conflicts_with_all = ["decode", "repr"])]
+    pub decode_latent: bool,
+    /// The latent model: a directory from 'mo-train --arch sata' [default: the built-in one].
+    #[arg(long, value_name = "DIR")]
+    pub model: Option<PathBuf>,
     #[command(flatten)]
     pub common: CommonOpts,
 }
@@ -203,6 +223,12 @@ impl Repr {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
+    if args.latent || args.decode_latent {
+        return latent(args);
+    }
+    if args.model.is_some() {
+        bail!("--model belongs to --latent and --decode-latent");
+    }
     refuse_anytop_flags(args)?;
     check_stdin(args)?;
     if args.decode {
@@ -210,6 +236,52 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     } else {
         encode(args)
     }
+}
+
+/// `--latent` / `--decode-latent`: one clip to latents, or latents to a BVH on --skeleton.
+fn latent(args: &Args) -> anyhow::Result<()> {
+    let given = [
+        (args.rest_pose.is_some(), "--rest-pose"),
+        (args.face_joints.is_some(), "--face-joints"),
+        (args.body_axis.is_some(), "--body-axis"),
+        (args.feet.is_some(), "--feet"),
+        (args.require_contacts, "--require-contacts"),
+        (args.normalise, "--normalise"),
+        (args.stats.is_some(), "--stats"),
+        (args.emit_skeleton.is_some(), "--emit-skeleton"),
+        (args.placement.is_some(), "--placement"),
+        (args.latent && args.skeleton.is_some(), "--skeleton (with --latent: the clip carries its skeleton)"),
+    ];
+    if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
+        bail!("{flag} does not apply to latents: the latent model builds each clip's rig itself");
+    }
+    let dash = args.inputs.iter().filter(|p| is_dash(p)).count() + usize::from(args.skeleton.as_deref().is_some_and(is_dash));
+    if dash > 1 || (args.decode_latent && args.inputs.is_empty() && args.skeleton.as_deref().is_some_and(is_dash)) {
+        bail!("stdin ('-') can be read only once");
+    }
+    let device = candle_core::Device::Cpu;
+    let model = super::latent::load_model(args.model.as_deref(), &device)?;
+    let bytes = if args.latent {
+        let [input] = args.inputs.as_slice() else { bail!("--latent encodes one BVH clip, {} given", args.inputs.len()) };
+        let clip = super::latent::read_source(input, &device)?;
+        let latents = super::latent::encode(&model, &clip, &device)?;
+        if args.common.output.as_deref().is_none_or(is_dash) && std::io::stdout().is_terminal() {
+            bail!("refusing to write binary NPY to a terminal: redirect stdout or give -o FILE");
+        }
+        super::latent::latents_npy(&latents)?
+    } else {
+        let input = match args.inputs.as_slice() {
+            [] => PathBuf::from("-"),
+            [one] => one.clone(),
+            more => bail!("--decode-latent reads one NPY of latents, {} given", more.len()),
+        };
+        let latents = super::latent::read_latents(&input)?;
+        let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
+        let target = super::latent::read_target(skeleton, &device)?;
+        let frame_time = target.arg.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
+        super::latent::decode_bvh(&model, &latents, &target, frame_time, &device)?.into_bytes()
+    };
+    io::write_output(args.common.output.as_deref(), &bytes).context("cannot write the output")
 }
 
 /// AnyTop's flags mean nothing to m2m (clap cannot tie a flag to another flag's value).

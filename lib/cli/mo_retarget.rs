@@ -25,7 +25,8 @@ EXAMPLES:
     mo-retarget examples/data/biped.bvh examples/data/quadruped.bvh --bind auto --emit-binding
     mo-retarget examples/data/quadruped.bvh examples/data/dragon.bvh --bind auto -n 3 -o 'd_{i}.bvh'
     mo-retarget examples/data/biped.bvh examples/data/biped.bvh --bind auto --seconds 2 -o b.bvh
-    cat examples/data/spider.bvh | mo-retarget - examples/data/crab.bvh --bind auto --format npy";
+    cat examples/data/spider.bvh | mo-retarget - examples/data/crab.bvh --bind auto --format npy
+    mo-retarget --method latent examples/data/biped.bvh --to examples/data/quadruped.bvh -o q.bvh";
 
 /// Transfer a motion to a different skeleton from a few example clips of it (Motion2Motion).
 ///
@@ -49,18 +50,35 @@ EXAMPLES:
 /// --format npy (Motion2Motion features [frames, joints, 9], or [n, frames, joints, 9] for -n).
 /// -n K writes K diverse samples (seeds --seed .. --seed+K-1) to -o PATTERN with '{i}'.
 /// --report prints timing, the binding, pyramid levels and per-level match cost on stderr.
+///
+/// --method latent (SATA, zero-shot): the source is encoded by the latent model (--model, or
+/// the built-in one trained on the synthetic zoo) into one vector per frame and decoded onto
+/// the target skeleton (--to, a BVH or skeleton document, or the first of TARGETS), conditioned
+/// only on its rest pose, topology and joint names. No example clips and no binding; the
+/// output has the source's frame time and one frame fewer than the source.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-retarget", version, after_long_help = EXAMPLES)]
 pub struct Args {
     /// The motion to transfer: a BVH file ('-' = stdin).
     #[arg(value_name = "SOURCE")]
     pub source: PathBuf,
-    /// Example clips of the target skeleton: BVH files or directories.
-    #[arg(value_name = "TARGETS", required = true, num_args = 1..)]
+    /// Example clips of the target skeleton: BVH files or directories (with --method latent,
+    /// only the first is read, for its skeleton; or give --to).
+    #[arg(value_name = "TARGETS", required_unless_present = "to", num_args = 0..)]
     pub targets: Vec<PathBuf>,
-    /// Binding JSON file, or 'auto'.
+    /// m2m: binding JSON file, or 'auto' (required).
     #[arg(long, value_name = "FILE|auto")]
-    pub bind: String,
+    pub bind: Option<String>,
+    /// How to transfer: m2m (Motion2Motion, from example clips and a sparse binding) or latent
+    /// (zero-shot through the SATA latent model: no examples, no binding).
+    #[arg(long, value_enum, default_value_t = Method::M2m)]
+    pub method: Method,
+    /// latent: the target skeleton, a BVH or a skeleton document (instead of TARGETS).
+    #[arg(long, value_name = "PATH")]
+    pub to: Option<PathBuf>,
+    /// latent: the model directory from 'mo-train --arch sata' [default: the built-in one].
+    #[arg(long, value_name = "DIR")]
+    pub model: Option<PathBuf>,
     /// Binding rate of --bind auto: 2 x pairs / (source joints + target joints).
     #[arg(long, value_name = "R", default_value_t = 0.061)]
     pub bind_rate: f64,
@@ -115,6 +133,12 @@ pub struct Args {
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    M2m,
+    Latent,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OutFormat {
     Bvh,
     Npy,
@@ -143,6 +167,51 @@ pub enum RootArg {
     Examples,
     /// The source's trajectory, scaled to the target's size.
     Source,
+}
+
+/// `--method latent`: encode the source with the latent model, decode onto the target skeleton.
+fn run_latent(args: &Args) -> anyhow::Result<()> {
+    let m2m_only = [
+        (args.bind.is_some(), "--bind"),
+        (args.emit_binding, "--emit-binding"),
+        (args.samples != 1, "-n"),
+        (args.frames.is_some() || args.seconds.is_some(), "--frames/--seconds"),
+        (args.key_frames.is_some(), "--key-frames"),
+        (args.format == OutFormat::Npy, "--format npy"),
+        (args.patch.is_some() || args.alpha.is_some() || args.steps.is_some() || args.pyramid.is_some(), "--patch/--alpha/--steps/--pyramid"),
+        (args.repr.is_some() || args.bound_rotation.is_some() || args.root_motion.is_some() || args.copy_bound, "--repr/--bound-rotation/--root-motion/--copy-bound"),
+    ];
+    if let Some((_, flag)) = m2m_only.iter().find(|(on, _)| *on) {
+        bail!("{flag} belongs to --method m2m; the latent method decodes one motion, as long as the source");
+    }
+    let target_path = match (&args.to, args.targets.first()) {
+        (Some(to), _) => to.clone(),
+        (None, Some(first)) => first.clone(),
+        (None, None) => bail!("--method latent needs the target skeleton: --to PATH or a TARGETS clip"),
+    };
+    if is_dash(&args.source) && is_dash(&target_path) {
+        bail!("stdin ('-') can be read only once");
+    }
+    let started = Instant::now();
+    let device = candle_core::Device::Cpu;
+    let model = super::latent::load_model(args.model.as_deref(), &device)?;
+    let source = super::latent::read_source(&args.source, &device)?;
+    let target = super::latent::read_target(&target_path, &device)?;
+    let latents = super::latent::encode(&model, &source, &device)?;
+    let text = super::latent::decode_bvh(&model, &latents, &target, source.motion.frame_time, &device)?;
+    if args.report {
+        eprintln!(
+            "mo-retarget: latent: {} ({} joints) -> {} ({} joints), {} frames, latent {} per frame, {:.2} s",
+            source.name,
+            source.skeleton.len(),
+            target.arg.name,
+            target.arg.skeleton.len(),
+            latents.frames,
+            latents.dims,
+            started.elapsed().as_secs_f64()
+        );
+    }
+    io::write_output(args.common.output.as_deref(), text.as_bytes()).context("cannot write the output")
 }
 
 /// One read clip.
@@ -247,6 +316,16 @@ fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Setti
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
+    if args.method == Method::Latent {
+        return run_latent(args);
+    }
+    if args.to.is_some() || args.model.is_some() {
+        bail!("--to and --model belong to --method latent; Motion2Motion reads TARGETS (example clips)");
+    }
+    if args.targets.is_empty() {
+        bail!("Motion2Motion needs TARGETS: example clips of the target skeleton");
+    }
+    let Some(bind) = args.bind.as_deref() else { bail!("--bind is required with --method m2m: a binding JSON file, or 'auto'") };
     let started = Instant::now();
     let count = args.samples as usize;
     let outputs: Vec<Option<PathBuf>> = match args.common.output.as_deref() {
@@ -293,14 +372,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 
     // The binding.
-    let (map, binding): (JointMap, Binding) = if args.bind == "auto" {
+    let (map, binding): (JointMap, Binding) = if bind == "auto" {
         let (ra, rb) = (canonical_rest(&source)?, canonical_rest(first)?);
         let opts = AutoOptions { rate: args.bind_rate, ..AutoOptions::default() };
         let choices = auto::auto_bind(&Body { skeleton: &source.skeleton, rest: &ra }, &Body { skeleton: &first.skeleton, rest: &rb }, &opts)?;
         let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
         (choices.iter().map(|c| (c.source, c.target)).collect(), binding)
     } else {
-        let path = Path::new(&args.bind);
+        let path = Path::new(bind);
         let name = io::display_name(path);
         let text = String::from_utf8(io::read_input(path).with_context(|| format!("cannot read binding {name}"))?)
             .map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))?;

@@ -7,6 +7,7 @@
 //! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
 pub mod docs;
+pub mod latent;
 pub mod load;
 pub mod mo_dift;
 pub mod mo_encode;

@@ -1,0 +1,107 @@
+//! The latent model's side of `mo-encode` (`--latent`, `--decode-latent`) and `mo-retarget
+//! --method latent`: load the SATA model, encode a clip into per-frame latents, decode latents
+//! onto a skeleton.
+
+use crate::cli::load::{read_skeleton, SkeletonArg};
+use crate::document::AnyTopSection;
+use crate::embed::NameTable;
+use crate::io::{self, npy};
+use crate::motion::Motion;
+use crate::sata::checkpoint::{self, Frozen};
+use crate::sata::infer::{Latents, Prepared};
+use crate::skeleton::Skeleton;
+use crate::bvh;
+use anyhow::{bail, Context};
+use candle_core::Device;
+use std::path::Path;
+
+/// `--model DIR`, or the built-in latent model (models/zoo-sata, see its MODEL_CARD.md).
+pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<Frozen> {
+    match dir {
+        Some(dir) => checkpoint::frozen(dir, device),
+        None => {
+            const INFO: &[u8] = include_bytes!("../../models/zoo-sata/checkpoint.json");
+            const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-sata/model.safetensors");
+            checkpoint::frozen_bytes(INFO, WEIGHTS, device).context("the built-in latent model")
+        }
+    }
+}
+
+/// A BVH clip read for encoding: skeleton, motion and its own AnyTop record (rig on its first
+/// frames, as `mo-encode` builds for a lone clip).
+pub struct SourceClip {
+    pub name: String,
+    pub skeleton: Skeleton,
+    pub motion: Motion,
+    pub prepared: Prepared,
+}
+
+pub fn read_source(path: &Path, device: &Device) -> anyhow::Result<SourceClip> {
+    let name = io::display_name(path);
+    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    if bytes.starts_with(b"\x93NUMPY") {
+        bail!("{name}: expected a BVH clip to encode, found an NPY file (decode features first: mo-encode --decode)");
+    }
+    let parsed = bvh::parse_bytes(&bytes, &name)?;
+    let skeleton = Skeleton::from_bvh(&parsed);
+    skeleton.validate().with_context(|| name.clone())?;
+    let motion = Motion::from_bvh(&parsed, &skeleton);
+    if motion.frames < 2 {
+        bail!("{name}: {} frame(s); a clip needs at least 2 frames to encode (velocities need a next frame)", motion.frames);
+    }
+    let section = AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig"))?;
+    let prepared = Prepared::new(&skeleton, section, names()?, device).with_context(|| name.clone())?;
+    Ok(SourceClip { name, skeleton, motion, prepared })
+}
+
+fn names() -> anyhow::Result<&'static NameTable> {
+    NameTable::builtin().context("the built-in joint-name table")
+}
+
+/// Per-frame latents of a clip (`[frames - 1, latent]`: AnyTop's features need a next frame).
+pub fn encode(model: &Frozen, clip: &SourceClip, device: &Device) -> anyhow::Result<Latents> {
+    let encoded = clip.prepared.section.rig.encode(&clip.skeleton, &clip.motion).with_context(|| format!("{}: cannot encode", clip.name))?;
+    if let Some((f, j, d)) = encoded.features.first_non_finite() {
+        bail!("{}: non-finite feature at frame {f}, joint {j}, dim {d}", clip.name);
+    }
+    model.encode_features(&encoded.features, &clip.prepared.graph, device).with_context(|| clip.name.clone())
+}
+
+/// The skeleton to decode onto (`--skeleton`/`--to`: a document or a BVH) with its rig and graph.
+pub struct Target {
+    pub arg: SkeletonArg,
+    pub prepared: Prepared,
+}
+
+pub fn read_target(path: &Path, device: &Device) -> anyhow::Result<Target> {
+    let arg = read_skeleton(path)?;
+    let section = arg.record()?;
+    let prepared = Prepared::new(&arg.skeleton, section, names()?, device).with_context(|| arg.name.clone())?;
+    Ok(Target { arg, prepared })
+}
+
+/// Latents `[frames, latent]` from an NPY file.
+pub fn read_latents(path: &Path) -> anyhow::Result<Latents> {
+    let name = io::display_name(path);
+    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    let array = npy::from_bytes(&bytes, &name)?;
+    let shape = array.shape.clone();
+    if shape.len() != 2 || shape[0] == 0 || shape[1] == 0 {
+        bail!("{name}: expected latents [frames, dims] (from mo-encode --latent), found shape {shape:?}");
+    }
+    let data = array.data;
+    if let Some(k) = data.iter().position(|v| !v.is_finite()) {
+        bail!("{name}: non-finite latent at frame {}, dim {}", k / shape[1], k % shape[1]);
+    }
+    Ok(Latents { frames: shape[0], dims: shape[1], data })
+}
+
+pub fn latents_npy(latents: &Latents) -> anyhow::Result<Vec<u8>> {
+    npy::to_bytes(&[latents.frames, latents.dims], &latents.data).context("building the NPY")
+}
+
+/// Decode onto the target as BVH text, `frame_time` seconds per frame.
+pub fn decode_bvh(model: &Frozen, latents: &Latents, target: &Target, frame_time: f64, device: &Device) -> anyhow::Result<String> {
+    let motion = model.decode_motion(latents, &target.arg.skeleton, &target.prepared, frame_time, device).with_context(|| format!("decoding onto {}", target.arg.name))?;
+    Ok(bvh::write_string(&motion.to_bvh(&target.arg.skeleton)))
+}
