@@ -114,6 +114,7 @@ impl Frozen {
             anyhow::bail!("latents: non-finite value at frame {}, dim {}", k / l, k % l);
         }
         let per_frame = g.joints * FEATURE_DIMS;
+        let scale = self.info.scale.tensor(g.joints, device)?;
         let mut out = Features::zeros(latents.frames, g.joints, FEATURE_DIMS);
         let list = windows(latents.frames, self.info.config.window, self.info.config.overlap);
         for group in list.chunks(WINDOWS_PER_PASS) {
@@ -123,7 +124,7 @@ impl Frozen {
                 data.extend_from_slice(&latents.data[w.start * l..(w.start + w.len) * l]);
             }
             let z = Tensor::from_vec(data, (group.len(), len, l), device)?;
-            let y: Vec<f32> = self.model.decode(&z, g)?.flatten_all()?.to_vec1()?;
+            let y: Vec<f32> = self.model.decode(&z, g, &scale)?.flatten_all()?.to_vec1()?;
             for (k, w) in group.iter().enumerate() {
                 let from = (k * len + w.keep_from) * per_frame;
                 let to = (k * len + w.len) * per_frame;

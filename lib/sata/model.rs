@@ -14,7 +14,10 @@
 //!   modulation by the source skeleton -> blocks -> max over joints -> LN -> mean and
 //!   log-variance of the per-frame latent.
 //! * Decoder: latent -> linear -> broadcast to every joint of the target -> modulation by the
-//!   target skeleton -> blocks -> LN -> 13 features per joint (root and joints own heads).
+//!   target skeleton -> blocks -> LN -> 13 features per joint (root and joints own heads), as
+//!   an offset from the target's rest pose standing still (`SkeletonGraph::rest`; our
+//!   addition: without it, a 400-step model put every creature's hips at the zoo's mean
+//!   height, 0.55 where a biped's are at 1.0).
 
 use super::graph::{SkeletonGraph, EDGE_DIMS};
 use super::{SataConfig, FEATURE_DIMS, INPUT_DIMS};
@@ -284,8 +287,10 @@ impl SataModel {
         Ok((stats.narrow(D::Minus1, 0, l)?, logvar))
     }
 
-    /// Scaled features `[B, T, J, 13]` of skeleton `g` from latents `[B, T, latent]`.
-    pub fn decode(&self, z: &Tensor, g: &SkeletonGraph) -> Result<Tensor, NnError> {
+    /// Scaled features `[B, T, J, 13]` of skeleton `g` from latents `[B, T, latent]`; `scale`
+    /// (`[1, 1, J, 13]`, `train::FeatureScale::tensor`) scales the rest pose the output is an
+    /// offset from.
+    pub fn decode(&self, z: &Tensor, g: &SkeletonGraph, scale: &Tensor) -> Result<Tensor, NnError> {
         let (b, t, l) = z.dims3()?;
         if l != self.cfg.latent || t == 0 || b == 0 {
             return Err(NnError::Shape { what: "latents", expected: format!("[B>0, T>0, {}]", self.cfg.latent), got: z.dims().to_vec() });
@@ -299,7 +304,8 @@ impl SataModel {
         for block in &self.dec_blocks {
             h = block.forward(&h, g, &s, &positions)?;
         }
-        Ok(self.motion_out.forward(&self.dec_norm.forward(&h)?)?)
+        let rest = g.rest.unsqueeze(0)?.unsqueeze(0)?.broadcast_div(scale)?;
+        Ok(self.motion_out.forward(&self.dec_norm.forward(&h)?)?.broadcast_add(&rest)?)
     }
 }
 

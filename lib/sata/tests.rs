@@ -47,7 +47,7 @@ fn latents_have_one_size_for_every_skeleton_and_decode_anywhere() {
     let (mu_crab, _) = model.encode(&tensor(&crab_f, 12, &scale), &crab).unwrap();
     assert_eq!(mu_dog.dims(), &[1, 12, 16]);
     assert_eq!(mu_crab.dims(), mu_dog.dims());
-    let on_crab = model.decode(&mu_dog, &crab).unwrap();
+    let on_crab = model.decode(&mu_dog, &crab, &scale.tensor(crab.joints, &Device::Cpu).unwrap()).unwrap();
     assert_eq!(on_crab.dims(), &[1, 12, crab.joints, 13]);
     let v: Vec<f32> = on_crab.flatten_all().unwrap().to_vec1().unwrap();
     assert!(v.iter().all(|x| x.is_finite()));

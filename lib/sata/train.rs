@@ -167,7 +167,7 @@ pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, we
     let (mu, logvar) = model.encode(x, g)?;
     let eps = Tensor::from_vec(gaussian(rng, mu.elem_count()), mu.shape(), mu.device())?;
     let z = (&mu + (logvar.clone() * 0.5)?.exp()?.mul(&eps)?)?;
-    let y = model.decode(&z, g)?;
+    let y = model.decode(&z, g, scale)?;
     let (_, t, j, _) = x.dims4()?;
     let rec = (&y - x)?.sqr()?.mean_all()?;
     // Rotations compared as rotations, in their own units.
