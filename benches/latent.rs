@@ -104,10 +104,13 @@ struct Encoded {
 }
 
 fn encode(clip: &Clip, device: &Device) -> Option<Encoded> {
-    let section = AnyTopSection::of_clip(&clip.skeleton, &clip.motion, &clip.name).ok()?;
-    let e = section.rig.encode(&clip.skeleton, &clip.motion).ok()?;
-    let prepared = Prepared::new(&clip.skeleton, section, NameTable::builtin().ok()?, device).ok()?;
-    Some(Encoded { prepared, features: e.features, placement: e.placement })
+    let go = || -> anyhow::Result<Encoded> {
+        let section = AnyTopSection::of_clip(&clip.skeleton, &clip.motion, &clip.name)?;
+        let e = section.rig.encode(&clip.skeleton, &clip.motion)?;
+        let prepared = Prepared::new(&clip.skeleton, section, NameTable::builtin()?, device)?;
+        Ok(Encoded { prepared, features: e.features, placement: e.placement })
+    };
+    go().map_err(|e| println!("(skipped {}: {e:#})", clip.name)).ok()
 }
 
 /// Every frame replaced by the clip's mean feature row: a still mean pose drifting at the mean
@@ -124,13 +127,16 @@ fn mean_pose(f: &Features) -> Features {
 
 /// Score `features` (decoded on `target` at its true placement) against `truth`.
 fn score(target: &Clip, enc: &Encoded, features: &Features) -> Option<ReconstructionReport> {
-    let result = enc.prepared.section.rig.decode(&target.skeleton, features, &enc.placement).ok()?;
-    let truth = target.motion.first_frames(result.frames);
-    let counted = rotation_joints(&target.skeleton);
-    let rotations = Rotations { reference: &truth.rotations, result: &result.rotations, counted };
-    let a = MetricClip::from_motion(&target.skeleton, &truth);
-    let b = MetricClip::from_motion(&target.skeleton, &result);
-    reconstruction(&a, &b, Some(&rotations), target.skeleton.rest_height(), &PhysicsOptions::default()).ok()
+    let go = || -> anyhow::Result<ReconstructionReport> {
+        let result = enc.prepared.section.rig.decode(&target.skeleton, features, &enc.placement)?;
+        let truth = target.motion.first_frames(result.frames);
+        let counted = rotation_joints(&target.skeleton);
+        let rotations = Rotations { reference: &truth.rotations, result: &result.rotations, counted };
+        let a = MetricClip::from_motion(&target.skeleton, &truth);
+        let b = MetricClip::from_motion(&target.skeleton, &result);
+        Ok(reconstruction(&a, &b, Some(&rotations), target.skeleton.rest_height(), &PhysicsOptions::default())?)
+    };
+    go().map_err(|e| println!("(not scored {}: {e:#})", target.name)).ok()
 }
 
 #[derive(Default)]
@@ -255,11 +261,43 @@ fn main() {
     println!("\n## Retargeting onto skel-aug variants (ground truth: the variant's own motion)\n");
     println!("| model / set / method | pairs | JR | RT | JP | FS | GP | SAN |\n|---|---|---|---|---|---|---|---|");
     transfer_rows.iter().for_each(|r| println!("{r}"));
+    ground_truth_pairs(&models, &device);
     println!("\n## Topology independence of the latents\n");
     println!("Mean per-frame L2 distance from a variant's latents to its original's (same motion, other skeleton) and to the other clips of the set; 'nearest' = the original is the closest clip.\n");
     println!("| model / set | variants | same motion | other motions | ratio | nearest |\n|---|---|---|---|---|---|");
     distance_rows.iter().for_each(|r| println!("{r}"));
     speed(&models, &device);
+}
+
+/// Corpus pairs of one motion on two skeletons: CMU 131_01 and its scaled copy (same topology,
+/// other proportions). SAN error of SATA's transfer against the target's mean pose.
+fn ground_truth_pairs(models: &[(String, Frozen)], device: &Device) {
+    let mut rows = Vec::new();
+    let corpus = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bvh");
+    let pairs = [("cmu_bvh11/131_01.bvh", "cmu_bvh11/scaled_131_01.bvh")];
+    for (a, b) in pairs {
+        let (Some(src), Some(dst)) = (read(&corpus.join(a)), read(&corpus.join(b))) else { continue };
+        let (Some(se), Some(de)) = (encode(&src, device), encode(&dst, device)) else { continue };
+        for (name, model) in models {
+            let Ok(z) = model.encode_features(&se.features, &se.prepared.graph, device) else { continue };
+            let Ok(on) = model.decode_latents(&z, &de.prepared.graph, device) else { continue };
+            let mut m = Mean::default();
+            let mut base = Mean::default();
+            if let Some(r) = score(&dst, &de, &on) {
+                m.add(&r);
+            }
+            if let Some(r) = score(&dst, &de, &mean_pose(&de.features)) {
+                base.add(&r);
+            }
+            rows.push(m.row(&format!("{name} / {a} -> {b} / SATA")));
+            rows.push(base.row(&format!("{name} / {a} -> {b} / target's mean pose")));
+        }
+    }
+    if !rows.is_empty() {
+        println!("\n## Retargeting between corpus skeletons with a ground truth\n");
+        println!("| model / pair / method | pairs | JR | RT | JP | FS | GP | SAN |\n|---|---|---|---|---|---|---|---|");
+        rows.iter().for_each(|r| println!("{r}"));
+    }
 }
 
 /// Encode + decode of a 1000-frame clip (a synthetic quadruped clip repeated), median of runs.
