@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Zero-shot retargeting through the latent model (SATA) side by side with Motion2Motion on the
-# same pairs: human (CMU, held out of the corpus model) -> dog, dog -> human, flamingo ->
+# same pairs: human (LAFAN1 walk, held out of the corpus model) -> dog, dog -> human, flamingo ->
 # chicken. Scores both with `mo-metrics transfer` (frequency alignment and contact consistency
 # over the pairs of an automatic binding, the same pairs for both methods) and renders PNG
 # sheets of source and results to look at.
@@ -13,10 +13,10 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=$ROOT/target/release
 DATA=${SHARED_DATA:-$ROOT/../shared/data}/bvh
-HUMAN=$DATA/cmu_bvh11/131_03.bvh
+HUMAN=$DATA/lafan1/walk4_subject1.bvh
 HUMAN_EX=$DATA/cmu_bvh11/131_01.bvh
 DOG=$DATA/dog_mann/Dog/D1_010_KAN01_002.bvh
-DOG_EX=$DATA/dog_mann/Dog/D1_007_KAN01_001.bvh
+DOG_EX=$DATA/dog_mann/Dog/D1_001_KAN01_001.bvh
 FLAMINGO=$DATA/truebones_motion2motion/Flamingo/Flamingo_Walk.bvh
 CHICKEN=$DATA/truebones_anytop/Chicken/Chicken_Walk.bvh
 CHICKEN_EX=$DATA/truebones_anytop/Chicken/Chicken_IdlePecking.bvh
