@@ -94,3 +94,22 @@ fn a_tiny_model_learns_to_reconstruct_one_clip() {
     }
     assert!(last < first * 0.5, "reconstruction MSE {first} -> {last}");
 }
+
+#[test]
+fn feature_scale_divides_by_group_rms_and_undoes_exactly() {
+    let (_, _, f) = clip("spider");
+    let scale = FeatureScale::measure([&f]);
+    scale.check().unwrap();
+    assert_eq!(scale.joint[12], 1.0, "contacts stay 0/1");
+    assert!(scale.joint[0] == scale.joint[2] && scale.joint[3] == scale.joint[8], "one value per group");
+    let mut g = f.clone();
+    scale.apply(&mut g);
+    // Every joint's position group has unit RMS after scaling.
+    let rms = (g.data.chunks_exact(13).enumerate().filter(|(k, _)| k % g.joints != 0).map(|(_, r)| r[..3].iter().map(|v| v * v).sum::<f32>()).sum::<f32>() / ((g.frames * (g.joints - 1) * 3) as f32)).sqrt();
+    assert!((rms - 1.0).abs() < 1e-3, "joint position RMS {rms}");
+    scale.undo(&mut g);
+    let worst = f.data.iter().zip(&g.data).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
+    assert!(worst < 1e-5, "apply + undo changed a value by {worst}");
+    let bad = FeatureScale { root: vec![0.0; 13], joint: scale.joint.clone() };
+    assert!(bad.check().is_err());
+}
