@@ -494,8 +494,8 @@ impl Trainer for SataTrainer<'_> {
         let mut rng = step_rng(self.info.seed, k);
         let l = sata::train::train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.info.scale, &self.info.weights, &mut rng, self.args.batch as usize, &self.device)?;
         let extra = format!(
-            ",\"reconstruction\":{},\"geodesic\":{},\"smooth\":{},\"contact\":{},\"penetration\":{},\"kl\":{}",
-            l.reconstruction, l.geodesic, l.smooth, l.contact, l.penetration, l.kl
+            ",\"reconstruction\":{},\"root\":{},\"geodesic\":{},\"smooth\":{},\"contact\":{},\"penetration\":{},\"kl\":{}",
+            l.reconstruction, l.root, l.geodesic, l.smooth, l.contact, l.penetration, l.kl
         );
         Ok((l.total, extra))
     }

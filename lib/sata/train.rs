@@ -111,6 +111,11 @@ pub fn raw_clips(set: &TrainSet) -> Vec<Features> {
 /// Loss weights (λ of §3.4); the defaults weigh each term about equally at the start.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LossWeights {
+    /// The root token's features again, on their own: in the plain MSE the root is one joint
+    /// of 20-100, yet its velocity and facing, integrated over the clip, are the whole root
+    /// trajectory (RT) and move every joint (JP).
+    #[serde(default = "one")]
+    pub root: f64,
     pub geodesic: f64,
     pub smooth: f64,
     pub contact: f64,
@@ -118,9 +123,13 @@ pub struct LossWeights {
     pub kl: f64,
 }
 
+fn one() -> f64 {
+    1.0
+}
+
 impl Default for LossWeights {
     fn default() -> LossWeights {
-        LossWeights { geodesic: 1.0, smooth: 1.0, contact: 0.1, penetration: 1.0, kl: 1e-4 }
+        LossWeights { root: 1.0, geodesic: 1.0, smooth: 1.0, contact: 0.1, penetration: 1.0, kl: 1e-4 }
     }
 }
 
@@ -129,6 +138,7 @@ impl Default for LossWeights {
 pub struct SataLosses {
     pub total: f64,
     pub reconstruction: f64,
+    pub root: f64,
     pub geodesic: f64,
     pub smooth: f64,
     pub contact: f64,
@@ -170,6 +180,7 @@ pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, we
     let y = model.decode(&z, g, scale)?;
     let (_, t, j, _) = x.dims4()?;
     let rec = (&y - x)?.sqr()?.mean_all()?;
+    let root = (y.narrow(2, 0, 1)? - x.narrow(2, 0, 1)?)?.sqr()?.mean_all()?;
     // Rotations compared as rotations, in their own units.
     let rot = |v: &Tensor| -> candle_core::Result<Tensor> { v.broadcast_mul(scale)?.narrow(3, 3, 6) };
     let geo = rotation_distance(&rot(&y)?, &rot(x)?)?.mean_all()?;
@@ -184,12 +195,13 @@ pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, we
     // Heights of the non-root joints (dim 1 is absolute height) below the floor.
     let penetration = if j > 1 { y.narrow(2, 1, j - 1)?.narrow(3, 1, 1)?.neg()?.relu()?.mean_all()? } else { rec.zeros_like()? };
     let kl = ((mu.sqr()? + logvar.exp()?)? - 1.0)?.sub(&logvar)?.mean_all()?.affine(0.5, 0.0)?;
-    let total = (((((&rec + (&geo * weights.geodesic)?)? + (&smooth * weights.smooth)?)? + (&contact * weights.contact)?)? + (&penetration * weights.penetration)?)?
+    let total = ((((((&rec + (&root * weights.root)?)? + (&geo * weights.geodesic)?)? + (&smooth * weights.smooth)?)? + (&contact * weights.contact)?)? + (&penetration * weights.penetration)?)?
         + (&kl * weights.kl)?)?;
     let v = |t: &Tensor| -> candle_core::Result<f64> { Ok(t.to_scalar::<f32>()? as f64) };
     let report = SataLosses {
         total: v(&total)?,
         reconstruction: v(&rec)?,
+        root: v(&root)?,
         geodesic: v(&geo)?,
         smooth: v(&smooth)?,
         contact: v(&contact)?,
