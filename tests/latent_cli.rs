@@ -43,6 +43,10 @@ fn decoding_onto_another_skeleton_gives_its_hierarchy_and_retarget_does_the_same
     let decoded = menagerie::skeleton::Skeleton::from_bvh(&parsed);
     assert_eq!(decoded.joints.iter().map(|j| &j.name).collect::<Vec<_>>(), dragon_skeleton.joints.iter().map(|j| &j.name).collect::<Vec<_>>());
     assert_eq!(parsed.frames, frames(&quad) - 1);
+    // Latents on stdin (a pipe from --latent) decode the same.
+    let piped = run("mo-encode", &["--decode-latent", "--skeleton", s(&dragon)], Some(&std::fs::read(&z).unwrap()));
+    ok(&piped, "decode from stdin");
+    assert_eq!(piped.stdout, std::fs::read(&out).unwrap());
     // The zero-shot path is the same two steps (both clips are at 30 fps).
     let retargeted = run("mo-retarget", &["--method", "latent", s(&quad), "--to", s(&dragon)], None);
     ok(&retargeted, "retarget");

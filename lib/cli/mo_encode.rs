@@ -104,8 +104,9 @@ EXAMPLES:
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-encode", version, after_long_help = EXAMPLES)]
 pub struct Args {
-    /// BVH files to encode ('-' = stdin); with --decode, one NPY file (default: stdin).
-    #[arg(value_name = "INPUT", required_unless_present = "decode")]
+    /// BVH files to encode ('-' = stdin); with --decode or --decode-latent, one NPY file
+    /// (default: stdin).
+    #[arg(value_name = "INPUT", required_unless_present_any = ["decode", "decode_latent"])]
     pub inputs: Vec<PathBuf>,
     /// Feature representation.
     #[arg(long, value_enum, default_value_t = Repr::Anytop)]
