@@ -452,7 +452,8 @@ fn run_sata(args: &Args) -> anyhow::Result<()> {
         cfg.validate()?;
         let set = training_set(args, args.common.seed, topology::DEFAULT_DMAX)?;
         // Measured once on the original data; a resumed run keeps the checkpoint's.
-        let scale = FeatureScale::measure(&sata::train::raw_clips(&set));
+        let raw = sata::train::raw_clips(&set);
+        let scale = FeatureScale::measure(raw.iter().map(|(f, rest)| (f, rest.as_slice())));
         let varmap = VarMap::new();
         let model = SataModel::new(seeded_var_builder(&varmap, args.common.seed, &device), &cfg)?;
         let info = SataInfo {

@@ -13,7 +13,8 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const FORMAT: &str = "menagerie.sata";
-pub const VERSION: u32 = 1;
+/// 2: features are offsets from the rest pose (`train::FeatureScale`); 1 scaled raw features.
+pub const VERSION: u32 = 2;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SataInfo {

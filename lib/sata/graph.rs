@@ -28,11 +28,22 @@ pub struct SkeletonGraph {
     pub scatter: Tensor,
     /// `[E, EDGE_DIMS]`.
     pub edges: Tensor,
-    /// `[J, 13]`: the AnyTop features of the natural rest pose standing still (positions
-    /// relative to the root's ground point, y absolute; identity 6D; no velocity or contact).
-    /// The decoder predicts the offset from it, so a skeleton's size and shape need not be
-    /// learned from the latent.
-    pub rest: Tensor,
+    /// `[J * 13]`: [`rest_row`], what the model's features are measured from.
+    pub rest: Vec<f32>,
+}
+
+/// The AnyTop features of the natural rest pose standing still, `[J * 13]`: positions relative
+/// to the root's ground point (y absolute), identity 6D, no velocity or contact. The model sees
+/// and predicts features as offsets from it (`train::FeatureScale`), so a skeleton's size and
+/// shape need not be learned, and the small motions around the pose are not drowned by it.
+pub fn rest_row(skeleton: &Skeleton, rig: &AnyTopRig) -> Vec<f32> {
+    let rest = rig.rest_positions(skeleton);
+    let mut row = vec![0f32; rest.len() * 13];
+    for (k, p) in rest.iter().enumerate() {
+        let q = if k == 0 { glam::DVec3::new(0.0, p.y, 0.0) } else { glam::DVec3::new(p.x - rest[0].x, p.y, p.z - rest[0].z) };
+        row[k * 13..k * 13 + 9].copy_from_slice(&[q.x as f32, q.y as f32, q.z as f32, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+    }
+    row
 }
 
 /// Bones from the root to each joint.
@@ -114,11 +125,6 @@ impl SkeletonGraph {
             scatter[dst * e + k] = 1.0;
             edges.extend_from_slice(f);
         }
-        let mut rest_row = vec![0f32; j * 13];
-        for (k, p) in rest.iter().enumerate() {
-            let q = if k == 0 { glam::DVec3::new(0.0, p.y, 0.0) } else { glam::DVec3::new(p.x - rest[0].x, p.y, p.z - rest[0].z) };
-            rest_row[k * 13..k * 13 + 9].copy_from_slice(&[q.x as f32, q.y as f32, q.z as f32, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
-        }
         let flat: Vec<f32> = names.iter().flatten().copied().collect();
         Ok(SkeletonGraph {
             joints: j,
@@ -127,7 +133,7 @@ impl SkeletonGraph {
             gather: Tensor::from_vec(gather, (e, j), device)?,
             scatter: Tensor::from_vec(scatter, (j, e), device)?,
             edges: Tensor::from_vec(edges, (e, EDGE_DIMS), device)?,
-            rest: Tensor::from_vec(rest_row, (j, 13), device)?,
+            rest: rest_row(skeleton, rig),
         })
     }
 }

@@ -77,7 +77,7 @@ impl Frozen {
             anyhow::bail!("no frames to encode");
         }
         let mut scaled = features.clone();
-        self.info.scale.apply(&mut scaled);
+        self.info.scale.apply(&mut scaled, &g.rest);
         let per_frame = g.joints * FEATURE_DIMS;
         let l = self.info.config.latent;
         let mut out = vec![0f32; features.frames * l];
@@ -114,7 +114,6 @@ impl Frozen {
             anyhow::bail!("latents: non-finite value at frame {}, dim {}", k / l, k % l);
         }
         let per_frame = g.joints * FEATURE_DIMS;
-        let scale = self.info.scale.tensor(g.joints, device)?;
         let mut out = Features::zeros(latents.frames, g.joints, FEATURE_DIMS);
         let list = windows(latents.frames, self.info.config.window, self.info.config.overlap);
         for group in list.chunks(WINDOWS_PER_PASS) {
@@ -124,14 +123,14 @@ impl Frozen {
                 data.extend_from_slice(&latents.data[w.start * l..(w.start + w.len) * l]);
             }
             let z = Tensor::from_vec(data, (group.len(), len, l), device)?;
-            let y: Vec<f32> = self.model.decode(&z, g, &scale)?.flatten_all()?.to_vec1()?;
+            let y: Vec<f32> = self.model.decode(&z, g)?.flatten_all()?.to_vec1()?;
             for (k, w) in group.iter().enumerate() {
                 let from = (k * len + w.keep_from) * per_frame;
                 let to = (k * len + w.len) * per_frame;
                 out.data[(w.start + w.keep_from) * per_frame..(w.start + w.len) * per_frame].copy_from_slice(&y[from..to]);
             }
         }
-        self.info.scale.undo(&mut out);
+        self.info.scale.undo(&mut out, &g.rest);
         Ok(out)
     }
 

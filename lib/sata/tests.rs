@@ -22,9 +22,9 @@ fn clip(name: &str) -> (crate::skeleton::Skeleton, SkeletonGraph, Features) {
     (skeleton, g, features)
 }
 
-fn tensor(f: &Features, frames: usize, scale: &FeatureScale) -> Tensor {
+fn tensor(f: &Features, frames: usize, scale: &FeatureScale, g: &SkeletonGraph) -> Tensor {
     let mut f = Features { frames, data: f.data[..frames * f.joints * f.dims].to_vec(), ..f.clone() };
-    scale.apply(&mut f);
+    scale.apply(&mut f, &g.rest);
     Tensor::from_vec(f.data, (1, frames, f.joints, f.dims), &Device::Cpu).unwrap()
 }
 
@@ -42,12 +42,12 @@ fn latents_have_one_size_for_every_skeleton_and_decode_anywhere() {
     let (_, dog, dog_f) = clip("quadruped");
     let (_, crab, crab_f) = clip("crab");
     assert_ne!(dog.joints, crab.joints);
-    let scale = FeatureScale::measure([&dog_f, &crab_f]);
-    let (mu_dog, _) = model.encode(&tensor(&dog_f, 12, &scale), &dog).unwrap();
-    let (mu_crab, _) = model.encode(&tensor(&crab_f, 12, &scale), &crab).unwrap();
+    let scale = FeatureScale::measure([(&dog_f, dog.rest.as_slice()), (&crab_f, crab.rest.as_slice())]);
+    let (mu_dog, _) = model.encode(&tensor(&dog_f, 12, &scale, &dog), &dog).unwrap();
+    let (mu_crab, _) = model.encode(&tensor(&crab_f, 12, &scale, &crab), &crab).unwrap();
     assert_eq!(mu_dog.dims(), &[1, 12, 16]);
     assert_eq!(mu_crab.dims(), mu_dog.dims());
-    let on_crab = model.decode(&mu_dog, &crab, &scale.tensor(crab.joints, &Device::Cpu).unwrap()).unwrap();
+    let on_crab = model.decode(&mu_dog, &crab).unwrap();
     assert_eq!(on_crab.dims(), &[1, 12, crab.joints, 13]);
     let v: Vec<f32> = on_crab.flatten_all().unwrap().to_vec1().unwrap();
     assert!(v.iter().all(|x| x.is_finite()));
@@ -58,8 +58,8 @@ fn every_parameter_gets_a_gradient() {
     let varmap = VarMap::new();
     let model = SataModel::new(seeded_var_builder(&varmap, 5, &Device::Cpu), &SataConfig::tiny()).unwrap();
     let (_, g, f) = clip("biped");
-    let scale = FeatureScale::measure([&f]);
-    let x = tensor(&f, 10, &scale);
+    let scale = FeatureScale::measure([(&f, g.rest.as_slice())]);
+    let x = tensor(&f, 10, &scale, &g);
     let s = scale.tensor(g.joints, &Device::Cpu).unwrap();
     let (total, report) = loss(&model, &x, &g, &s, &LossWeights::default(), &mut SplitMix64::new(1)).unwrap();
     assert!(report.total.is_finite() && report.total > 0.0, "{report:?}");
@@ -78,8 +78,8 @@ fn a_tiny_model_learns_to_reconstruct_one_clip() {
     let varmap = VarMap::new();
     let model = SataModel::new(seeded_var_builder(&varmap, 7, &Device::Cpu), &SataConfig::tiny()).unwrap();
     let (_, g, f) = clip("quadruped");
-    let scale = FeatureScale::measure([&f]);
-    let x = tensor(&f, 16, &scale);
+    let scale = FeatureScale::measure([(&f, g.rest.as_slice())]);
+    let x = tensor(&f, 16, &scale, &g);
     let s = scale.tensor(g.joints, &Device::Cpu).unwrap();
     let vars = named_vars(&varmap);
     let mut opt = crate::diffusion::train::AdamW::new(3e-3);
@@ -97,18 +97,22 @@ fn a_tiny_model_learns_to_reconstruct_one_clip() {
 
 #[test]
 fn feature_scale_divides_by_group_rms_and_undoes_exactly() {
-    let (_, _, f) = clip("spider");
-    let scale = FeatureScale::measure([&f]);
+    let (_, g, f) = clip("spider");
+    let scale = FeatureScale::measure([(&f, g.rest.as_slice())]);
     scale.check().unwrap();
     assert_eq!(scale.joint[12], 1.0, "contacts stay 0/1");
     assert!(scale.joint[0] == scale.joint[2] && scale.joint[3] == scale.joint[8], "one value per group");
-    let mut g = f.clone();
-    scale.apply(&mut g);
+    let mut h = f.clone();
+    scale.apply(&mut h, &g.rest);
     // Every joint's position group has unit RMS after scaling.
-    let rms = (g.data.chunks_exact(13).enumerate().filter(|(k, _)| k % g.joints != 0).map(|(_, r)| r[..3].iter().map(|v| v * v).sum::<f32>()).sum::<f32>() / ((g.frames * (g.joints - 1) * 3) as f32)).sqrt();
+    let rms = (h.data.chunks_exact(13).enumerate().filter(|(k, _)| k % h.joints != 0).map(|(_, r)| r[..3].iter().map(|v| v * v).sum::<f32>()).sum::<f32>() / ((h.frames * (h.joints - 1) * 3) as f32)).sqrt();
     assert!((rms - 1.0).abs() < 1e-3, "joint position RMS {rms}");
-    scale.undo(&mut g);
-    let worst = f.data.iter().zip(&g.data).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
+    // The rest pose itself is all zeros.
+    let mut still = Features { frames: 1, data: g.rest.clone(), ..f.clone() };
+    scale.apply(&mut still, &g.rest);
+    assert!(still.data.iter().all(|&v| v == 0.0));
+    scale.undo(&mut h, &g.rest);
+    let worst = f.data.iter().zip(&h.data).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
     assert!(worst < 1e-5, "apply + undo changed a value by {worst}");
     let bad = FeatureScale { root: vec![0.0; 13], joint: scale.joint.clone() };
     assert!(bad.check().is_err());

@@ -9,7 +9,7 @@
 //! representation, augmentation and grouping), de-normalised and divided by a global
 //! [`FeatureScale`] instead of per-skeleton statistics (see the module doc of `sata`).
 
-use super::graph::SkeletonGraph;
+use super::graph::{rest_row, SkeletonGraph};
 use super::{SataModel, FEATURE_DIMS};
 use crate::diffusion::data::{Crop, TrainSet};
 use crate::diffusion::train::{gaussian, rotation_distance, AdamW};
@@ -22,9 +22,11 @@ use std::collections::BTreeMap;
 /// Feature groups of AnyTop's 13 dims: position, 6D rotation, velocity, contact.
 const GROUPS: [(usize, usize); 4] = [(0, 3), (3, 9), (9, 12), (12, 13)];
 
-/// One divisor per feature dim, for the root token and for the other joints: the root-mean-
-/// square of the dim's group over the training set (contacts stay 0/1). Dividing (no mean
-/// shift) keeps zero velocity at zero, and the same numbers serve every skeleton.
+/// How features become the model's numbers: `(x - rest) / scale`, with `rest` the skeleton's
+/// [`graph::rest_row`] and one divisor per feature dim, for the root token and for the other
+/// joints: the root-mean-square of the dim's group of `x - rest` over the training set
+/// (contacts stay 0/1). Offsets from the rest pose make the motion, not the body, the signal;
+/// dividing (no mean shift) keeps zero velocity at zero; the same numbers serve every skeleton.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FeatureScale {
     pub root: Vec<f32>,
@@ -32,16 +34,22 @@ pub struct FeatureScale {
 }
 
 impl FeatureScale {
-    /// From raw (not normalised) AnyTop features of many skeletons.
-    pub fn measure<'a>(clips: impl IntoIterator<Item = &'a Features>) -> FeatureScale {
+    /// From raw (not normalised) AnyTop features of many skeletons, each with its rest row.
+    pub fn measure<'a>(clips: impl IntoIterator<Item = (&'a Features, &'a [f32])>) -> FeatureScale {
         let mut sums = [[0f64; 4]; 2];
         let mut counts = [[0f64; 4]; 2];
-        for c in clips {
-            for (k, row) in c.data.chunks_exact(FEATURE_DIMS).enumerate() {
-                let side = usize::from(k % c.joints.max(1) != 0);
-                for (g, &(a, b)) in GROUPS.iter().enumerate() {
-                    sums[side][g] += row[a..b].iter().map(|&v| (v as f64) * (v as f64)).sum::<f64>();
-                    counts[side][g] += (b - a) as f64;
+        for (c, rest) in clips {
+            let width = c.joints * FEATURE_DIMS;
+            if rest.len() != width {
+                continue;
+            }
+            for frame in c.data.chunks_exact(width) {
+                for (k, (row, r)) in frame.chunks_exact(FEATURE_DIMS).zip(rest.chunks_exact(FEATURE_DIMS)).enumerate() {
+                    let side = usize::from(k != 0);
+                    for (g, &(a, b)) in GROUPS.iter().enumerate() {
+                        sums[side][g] += (a..b).map(|d| ((row[d] - r[d]) as f64).powi(2)).sum::<f64>();
+                        counts[side][g] += (b - a) as f64;
+                    }
                 }
             }
         }
@@ -75,34 +83,40 @@ impl FeatureScale {
         Tensor::from_vec(v, (1, 1, joints, FEATURE_DIMS), device)
     }
 
-    /// Divide raw features in place.
-    pub fn apply(&self, f: &mut Features) {
-        let joints = f.joints.max(1);
-        for (k, row) in f.data.chunks_exact_mut(FEATURE_DIMS).enumerate() {
-            let s = if k % joints == 0 { &self.root } else { &self.joint };
-            row.iter_mut().zip(s).for_each(|(v, s)| *v /= s);
+    /// Raw features -> the model's numbers, in place (`rest`: `[J * 13]`).
+    pub fn apply(&self, f: &mut Features, rest: &[f32]) {
+        let width = f.joints * FEATURE_DIMS;
+        for frame in f.data.chunks_exact_mut(width.max(1)) {
+            for (k, (row, r)) in frame.chunks_exact_mut(FEATURE_DIMS).zip(rest.chunks_exact(FEATURE_DIMS)).enumerate() {
+                let s = if k == 0 { &self.root } else { &self.joint };
+                row.iter_mut().zip(r).zip(s).for_each(|((v, r), s)| *v = (*v - r) / s);
+            }
         }
     }
 
-    /// Multiply scaled features back in place.
-    pub fn undo(&self, f: &mut Features) {
-        let joints = f.joints.max(1);
-        for (k, row) in f.data.chunks_exact_mut(FEATURE_DIMS).enumerate() {
-            let s = if k % joints == 0 { &self.root } else { &self.joint };
-            row.iter_mut().zip(s).for_each(|(v, s)| *v *= s);
+    /// The model's numbers -> raw features, in place.
+    pub fn undo(&self, f: &mut Features, rest: &[f32]) {
+        let width = f.joints * FEATURE_DIMS;
+        for frame in f.data.chunks_exact_mut(width.max(1)) {
+            for (k, (row, r)) in frame.chunks_exact_mut(FEATURE_DIMS).zip(rest.chunks_exact(FEATURE_DIMS)).enumerate() {
+                let s = if k == 0 { &self.root } else { &self.joint };
+                row.iter_mut().zip(r).zip(s).for_each(|((v, r), s)| *v = *v * s + r);
+            }
         }
     }
 }
 
-/// Raw features of every clip of every skeleton (and variant) in the set.
-pub fn raw_clips(set: &TrainSet) -> Vec<Features> {
+/// Raw features of every clip of every skeleton (and variant) in the set, with the rest row
+/// of its skeleton.
+pub fn raw_clips(set: &TrainSet) -> Vec<(Features, Vec<f32>)> {
     let all = set.skeletons.iter().chain(set.augmented.iter().flatten());
     all.flat_map(|sk| {
+        let rest = rest_row(&sk.skeleton, &sk.section.rig);
         sk.clips.iter().map(move |c| {
             let mut f = c.clone();
             // Statistics were computed from these very clips: shapes match.
             let _ = sk.stats.denormalise(&mut f);
-            f
+            (f, rest.clone())
         })
     })
     .collect()
@@ -157,32 +171,34 @@ pub fn draw_crops(set: &TrainSet, rng: &mut SplitMix64, batch: usize, frames: us
     clips.into_iter().map(|c| Crop { clip: c, start: rng.below(sk.clips[c].frames - len + 1), frames: len, ..first }).collect()
 }
 
-/// Scaled features `[B, T, J, 13]` of same-skeleton crops.
-pub fn batch_tensor(set: &TrainSet, crops: &[Crop], scale: &FeatureScale, device: &Device) -> anyhow::Result<Tensor> {
+/// Scaled features `[B, T, J, 13]` of same-skeleton crops (`rest`: their skeleton's rest row).
+pub fn batch_tensor(set: &TrainSet, crops: &[Crop], scale: &FeatureScale, rest: &[f32], device: &Device) -> anyhow::Result<Tensor> {
     let first = crops.first().ok_or_else(|| anyhow::anyhow!("empty batch"))?;
     let sk = set.data(first);
     let mut data = Vec::new();
     for c in crops {
         let mut f = set.crop(c);
         sk.stats.denormalise(&mut f)?;
-        scale.apply(&mut f);
+        scale.apply(&mut f, rest);
         data.extend_from_slice(&f.data);
     }
     Ok(Tensor::from_vec(data, (crops.len(), first.frames, sk.skeleton.len(), FEATURE_DIMS), device)?)
 }
 
 /// The loss of reconstructing `x` (scaled, `[B, T, J, 13]`) through the model, with the VAE's
-/// sampled latent (noise from `rng`).
+/// sampled latent (noise from `rng`); `scale` is `FeatureScale::tensor` for the skeleton.
 pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> anyhow::Result<(Tensor, SataLosses)> {
     let (mu, logvar) = model.encode(x, g)?;
     let eps = Tensor::from_vec(gaussian(rng, mu.elem_count()), mu.shape(), mu.device())?;
     let z = (&mu + (logvar.clone() * 0.5)?.exp()?.mul(&eps)?)?;
-    let y = model.decode(&z, g, scale)?;
+    let y = model.decode(&z, g)?;
+    let rest = Tensor::from_slice(&g.rest, (1, 1, g.joints, FEATURE_DIMS), x.device())?;
+    let raw = |v: &Tensor| -> candle_core::Result<Tensor> { v.broadcast_mul(scale)?.broadcast_add(&rest) };
     let (_, t, j, _) = x.dims4()?;
     let rec = (&y - x)?.sqr()?.mean_all()?;
     let root = (y.narrow(2, 0, 1)? - x.narrow(2, 0, 1)?)?.sqr()?.mean_all()?;
     // Rotations compared as rotations, in their own units.
-    let rot = |v: &Tensor| -> candle_core::Result<Tensor> { v.broadcast_mul(scale)?.narrow(3, 3, 6) };
+    let rot = |v: &Tensor| -> candle_core::Result<Tensor> { raw(v)?.narrow(3, 3, 6) };
     let geo = rotation_distance(&rot(&y)?, &rot(x)?)?.mean_all()?;
     let smooth = if t > 1 {
         let diff = |v: &Tensor| -> candle_core::Result<Tensor> { v.narrow(1, 1, t - 1)? - v.narrow(1, 0, t - 1)? };
@@ -193,7 +209,7 @@ pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, we
     // Feet in contact in the data: the output's velocity there should be zero.
     let contact = x.narrow(3, 12, 1)?.broadcast_mul(&y.narrow(3, 9, 3)?.sqr()?)?.mean_all()?;
     // Heights of the non-root joints (dim 1 is absolute height) below the floor.
-    let penetration = if j > 1 { y.narrow(2, 1, j - 1)?.narrow(3, 1, 1)?.neg()?.relu()?.mean_all()? } else { rec.zeros_like()? };
+    let penetration = if j > 1 { raw(&y)?.narrow(2, 1, j - 1)?.narrow(3, 1, 1)?.neg()?.relu()?.mean_all()? } else { rec.zeros_like()? };
     let kl = ((mu.sqr()? + logvar.exp()?)? - 1.0)?.sub(&logvar)?.mean_all()?.affine(0.5, 0.0)?;
     let total = ((((((&rec + (&root * weights.root)?)? + (&geo * weights.geodesic)?)? + (&smooth * weights.smooth)?)? + (&contact * weights.contact)?)? + (&penetration * weights.penetration)?)?
         + (&kl * weights.kl)?)?;
@@ -228,7 +244,7 @@ pub fn train_step(
     let first = crops.first().ok_or_else(|| anyhow::anyhow!("the training set gave no crop"))?;
     let sk = set.data(first);
     let g = SkeletonGraph::new(&sk.skeleton, &sk.section.rig, &sk.names, device)?;
-    let x = batch_tensor(set, &crops, scale, device)?;
+    let x = batch_tensor(set, &crops, scale, &g.rest, device)?;
     let scale_t = scale.tensor(sk.skeleton.len(), device)?;
     let (total, report) = loss(model, &x, &g, &scale_t, weights, rng)?;
     if !report.total.is_finite() {
