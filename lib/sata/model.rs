@@ -11,7 +11,7 @@
 //!   h += MLP(LN(h)); then per joint over the window's frames h += TemporalAttention(LN(h) +
 //!   sinusoidal position); h += FF(LN(h)).
 //! * Encoder: motion input (root and other joints through their own linears, as AnyTop's) ->
-//!   modulation by the source skeleton -> blocks -> max over joints -> LN -> mean and
+//!   modulation by the source skeleton -> blocks -> max + mean over joints -> LN -> mean and
 //!   log-variance of the per-frame latent.
 //! * Decoder: latent -> linear -> broadcast to every joint of the target -> modulation by the
 //!   target skeleton -> blocks -> LN -> 13 features per joint (root and joints own heads).
@@ -282,8 +282,11 @@ impl SataModel {
         for block in &self.enc_blocks {
             h = block.forward(&h, g, &s, &positions)?;
         }
-        // Spatial max-pool: whatever the joint count, one vector per frame.
-        let pooled = self.enc_norm.forward(&h.max(2)?)?;
+        // Spatial pooling: whatever the joint count, one vector per frame. The paper max-pools;
+        // we add the mean: a max passes gradient to one joint per channel, and early in
+        // training the same few joints win every channel, so the others' motion never reaches
+        // the latent (a 500-step model learned the root's motion and no joint's rotation).
+        let pooled = self.enc_norm.forward(&(h.max(2)? + h.mean(2)?)?)?;
         let stats = self.to_latent.forward(&pooled)?;
         let l = self.cfg.latent;
         let logvar = stats.narrow(D::Minus1, l, l)?.clamp(-12f32, 8f32)?;
