@@ -149,20 +149,21 @@ impl Layer {
     }
 }
 
-/// Root (joint 0) and other joints through separate linears, as the reference.
+/// Root (joint 0) and other joints through separate linears, as the reference (SATA's input
+/// and output layers too).
 #[derive(Clone, Debug)]
-struct PerJointType {
+pub(crate) struct PerJointType {
     root: Linear,
     joint: Linear,
 }
 
 impl PerJointType {
-    fn new(vb: VarBuilder, inputs: usize, outputs: usize) -> candle_core::Result<PerJointType> {
+    pub(crate) fn new(vb: VarBuilder, inputs: usize, outputs: usize) -> candle_core::Result<PerJointType> {
         Ok(PerJointType { root: Linear::new(vb.pp("root"), inputs, outputs)?, joint: Linear::new(vb.pp("joint"), inputs, outputs)? })
     }
 
     /// `x`: `[B, T, J, inputs]` -> `[B, T, J, outputs]`.
-    fn forward(&self, x: &Tensor) -> candle_core::Result<Tensor> {
+    pub(crate) fn forward(&self, x: &Tensor) -> candle_core::Result<Tensor> {
         let j = x.dim(2)?;
         let root = self.root.forward(&x.narrow(2, 0, 1)?)?;
         if j == 1 {

@@ -24,7 +24,7 @@
 
 use super::graph::{SkeletonGraph, EDGE_DIMS};
 use super::{SataConfig, FEATURE_DIMS, INPUT_DIMS};
-use crate::nn::anytop::project_qkv;
+use crate::nn::anytop::{project_qkv, PerJointType};
 use crate::nn::fused::{self, Groups, Keys};
 use crate::nn::layers::{sinusoid, FeedForward, LayerNorm, Linear};
 use crate::nn::NnError;
@@ -43,29 +43,6 @@ fn spatial_encoding(statics: &Tensor, frequencies: usize) -> candle_core::Result
     let j = statics.dim(0)?;
     let phi = statics.unsqueeze(2)?.broadcast_mul(&freqs.reshape((1, 1, frequencies))?)?;
     Tensor::cat(&[phi.sin()?, phi.cos()?], 2)?.reshape((j, 6 * 2 * frequencies))
-}
-
-/// Root (joint 0) and the other joints through their own linears.
-#[derive(Clone, Debug)]
-struct RootAndJoints {
-    root: Linear,
-    joint: Linear,
-}
-
-impl RootAndJoints {
-    fn new(vb: VarBuilder, inputs: usize, outputs: usize) -> candle_core::Result<RootAndJoints> {
-        Ok(RootAndJoints { root: Linear::new(vb.pp("root"), inputs, outputs)?, joint: Linear::new(vb.pp("joint"), inputs, outputs)? })
-    }
-
-    /// `[B, T, J, inputs]` -> `[B, T, J, outputs]`.
-    fn forward(&self, x: &Tensor) -> candle_core::Result<Tensor> {
-        let j = x.dim(2)?;
-        let root = self.root.forward(&x.narrow(2, 0, 1)?)?;
-        if j == 1 {
-            return Ok(root);
-        }
-        Tensor::cat(&[root, self.joint.forward(&x.narrow(2, 1, j - 1)?)?], 2)
-    }
 }
 
 #[derive(Clone, Debug)]
@@ -228,7 +205,7 @@ fn frame_positions(t: usize, d: usize, device: &candle_core::Device) -> candle_c
 #[derive(Clone, Debug)]
 pub struct SataModel {
     cfg: SataConfig,
-    motion_in: RootAndJoints,
+    motion_in: PerJointType,
     enc_modulation: Modulation,
     enc_blocks: Vec<Block>,
     enc_norm: LayerNorm,
@@ -237,7 +214,7 @@ pub struct SataModel {
     dec_modulation: Modulation,
     dec_blocks: Vec<Block>,
     dec_norm: LayerNorm,
-    motion_out: RootAndJoints,
+    motion_out: PerJointType,
 }
 
 impl SataModel {
@@ -251,7 +228,7 @@ impl SataModel {
         let blocks = |vb: VarBuilder| (0..cfg.blocks).map(|k| Block::new(vb.pp("blocks").pp(k), cfg)).collect::<candle_core::Result<Vec<_>>>();
         Ok(SataModel {
             cfg: cfg.clone(),
-            motion_in: RootAndJoints::new(enc.pp("input"), INPUT_DIMS, d)?,
+            motion_in: PerJointType::new(enc.pp("input"), INPUT_DIMS, d)?,
             enc_modulation: Modulation::new(enc.pp("modulation"), cfg)?,
             enc_blocks: blocks(enc.clone())?,
             enc_norm: LayerNorm::new(enc.pp("norm"), d, cfg.ln_eps)?,
@@ -260,7 +237,7 @@ impl SataModel {
             dec_modulation: Modulation::new(dec.pp("modulation"), cfg)?,
             dec_blocks: blocks(dec.clone())?,
             dec_norm: LayerNorm::new(dec.pp("norm"), d, cfg.ln_eps)?,
-            motion_out: RootAndJoints::new(dec.pp("output"), d, FEATURE_DIMS)?,
+            motion_out: PerJointType::new(dec.pp("output"), d, FEATURE_DIMS)?,
         })
     }
 
