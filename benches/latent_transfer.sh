@@ -33,13 +33,13 @@ MODELS=("$@")
 [ ${#MODELS[@]} -gt 0 ] || MODELS=(builtin)
 
 # The first 300 frames of a BVH (long captures make slow, unreadable sheets).
-cut() {
+first_frames() {
     awk -v n=300 '/^MOTION/ { m = 1; print; next } !m { print; next }
         /^Frames:/ { next } /^Frame Time/ { ft = $0; next }
         NF > 0 { if (k < n) d[k++] = $0 } END { print "Frames: " k; print ft; for (i = 0; i < k; i++) print d[i] }' "$1" >"$2"
 }
-cut "$HUMAN" "$OUT/human.bvh"
-cut "$DOG" "$OUT/dog.bvh"
+first_frames "$HUMAN" "$OUT/human.bvh"
+first_frames "$DOG" "$OUT/dog.bvh"
 cp "$FLAMINGO" "$OUT/flamingo.bvh"
 
 echo "| pair | method | model | frequency alignment | contact consistency | seconds |"
