@@ -128,17 +128,12 @@ pub struct LossWeights {
     /// The root token's features again, on their own: in the plain MSE the root is one joint
     /// of 20-100, yet its velocity and facing, integrated over the clip, are the whole root
     /// trajectory (RT) and move every joint (JP).
-    #[serde(default = "one")]
     pub root: f64,
     pub geodesic: f64,
     pub smooth: f64,
     pub contact: f64,
     pub penetration: f64,
     pub kl: f64,
-}
-
-fn one() -> f64 {
-    1.0
 }
 
 impl Default for LossWeights {
