@@ -4,8 +4,9 @@
 //! `skel-aug` variants (10-30% of the joints removed, 2 added; surviving joints keep their
 //! names); left/right confusions counted apart, raw and centred descriptors (`dift::centred`),
 //! clips at temporal position 0. Then frame correspondence against a time-warped copy (mean
-//! frame error; each draw at a random temporal position, `DiftOptions::shift`), and the time
-//! one extraction takes.
+//! frame error; each draw at a random temporal position, `DiftOptions::shift`; descriptors
+//! the joint mean or the joints side by side, `dift::frame_descriptors`; matched frame by frame
+//! and in time order, `correspond::monotonic_matches`), and the time one extraction takes.
 //!
 //!     cargo bench --bench dift                       # built-in model
 //!     MENAGERIE_DIFT_MODEL=DIR cargo bench --bench dift
@@ -19,7 +20,7 @@ use menagerie::augment::{self, RemoveAmount};
 use menagerie::bvh;
 use menagerie::diffusion::checkpoint::{self, Frozen};
 use menagerie::diffusion::Schedule;
-use menagerie::dift::correspond::{best_matches, cosine_matrix};
+use menagerie::dift::correspond::{self, best_matches, cosine_matrix};
 use menagerie::dift::eval::{self, Accuracy};
 use menagerie::dift::{self, DiftOptions};
 use menagerie::document::AnyTopSection;
@@ -76,7 +77,8 @@ fn facing_rest(s: &Skeleton, m: &Motion) -> Option<Vec<glam::DVec3>> {
 /// Per setting: [raw, centred] per-joint and per-frame descriptors.
 struct Extracted {
     per_joint: Vec<[Vec<Vec<f32>>; 2]>,
-    per_frame: Vec<[Vec<Vec<f32>>; 2]>,
+    /// Per setting: features with each draw at a random temporal position (for frames).
+    shifted: Vec<dift::DiftFeatures>,
     raw_frames: Vec<Vec<f32>>,
     seconds: f64,
 }
@@ -85,18 +87,18 @@ fn extract_all(model: &Frozen, s: &Skeleton, m: &Motion, name: &str) -> anyhow::
     let prepared = dift::prepare(&model.info, s, m, name)?;
     let schedule = Schedule::cosine(model.info.schedule_steps);
     let cond = prepared.condition.condition();
-    let (mut per_joint, mut per_frame) = (Vec::new(), Vec::new());
+    let (mut per_joint, mut shifted_all) = (Vec::new(), Vec::new());
     let started = Instant::now();
     for &(t, layer) in &SETTINGS {
         let extract = |shift| dift::extract(&model.model, &schedule, &cond, &prepared.features, &DiftOptions { t, layer, draws: DRAWS, seed: 0, shift }, &Device::Cpu);
         let (fixed, shifted) = (extract(false)?, extract(true)?);
         per_joint.push([fixed.per_joint(), dift::centred(fixed.per_joint())]);
-        per_frame.push([shifted.per_frame(), dift::centred(shifted.per_frame())]);
+        shifted_all.push(shifted);
     }
     let seconds = started.elapsed().as_secs_f64() / SETTINGS.len() as f64;
     let per = prepared.features.joints * prepared.features.dims;
     let raw_frames = prepared.features.data.chunks(per).map(|c| c.to_vec()).collect();
-    Ok(Extracted { per_joint, per_frame, raw_frames, seconds })
+    Ok(Extracted { per_joint, shifted: shifted_all, raw_frames, seconds })
 }
 
 fn main() {
@@ -118,7 +120,7 @@ fn main() {
         .collect();
     // (set, target kind) -> per method accuracy.
     let mut joints: BTreeMap<(String, &str), Vec<Accuracy>> = BTreeMap::new();
-    let mut frames: BTreeMap<String, Vec<(f64, usize)>> = BTreeMap::new();
+    let mut frames: BTreeMap<(String, &str), Vec<(f64, usize)>> = BTreeMap::new();
     let mut timing = Vec::new();
     for clip in clips() {
         let Ok(reference) = extract_all(&model, &clip.skeleton, &clip.motion, &clip.name) else {
@@ -156,18 +158,25 @@ fn main() {
         let (warped, truth) = eval::time_warp(&clip.motion, 0.5);
         if let Ok(w) = extract_all(&model, &clip.skeleton, &warped, &clip.name) {
             // Feature frame k is BVH frame k; the last BVH frame has no features.
-            let n = w.per_frame[0][0].len();
+            let n = w.shifted[0].frames();
             let truth = &truth[..n];
-            let mut errors: Vec<f64> = (0..SETTINGS.len())
-                .flat_map(|k| (0..2).map(move |v| (k, v)))
-                .map(|(k, v)| eval::frame_error(&best_matches(&cosine_matrix(&w.per_frame[k][v], &reference.per_frame[k][v])), truth))
+            let mut sims: Vec<Vec<Vec<f64>>> = (0..SETTINGS.len())
+                .flat_map(|k| [false, true].map(move |same| (k, same)))
+                .map(|(k, same)| {
+                    let (r, t) = dift::frame_descriptors(&reference.shifted[k], &w.shifted[k], same);
+                    cosine_matrix(&t, &r)
+                })
                 .collect();
-            errors.push(eval::frame_error(&best_matches(&cosine_matrix(&w.raw_frames, &reference.raw_frames)), truth));
-            errors.push(truth.iter().enumerate().map(|(k, x)| (k as f64 - x).abs()).sum::<f64>() / n.max(1) as f64);
-            let row = frames.entry(clip.set.to_string()).or_insert_with(|| vec![(0.0, 0); errors.len()]);
-            for (r, e) in row.iter_mut().zip(errors) {
-                r.0 += e;
-                r.1 += 1;
+            sims.push(cosine_matrix(&w.raw_frames, &reference.raw_frames));
+            let unmatched = truth.iter().enumerate().map(|(k, x)| (k as f64 - x).abs()).sum::<f64>() / n.max(1) as f64;
+            for (align, matcher) in [("nearest", best_matches as fn(&[Vec<f64>]) -> Vec<_>), ("monotonic", correspond::monotonic_matches)] {
+                let mut errors: Vec<f64> = sims.iter().map(|sim| eval::frame_error(&matcher(sim), truth)).collect();
+                errors.push(unmatched);
+                let row = frames.entry((clip.set.to_string(), align)).or_insert_with(|| vec![(0.0, 0); errors.len()]);
+                for (r, e) in row.iter_mut().zip(errors) {
+                    r.0 += e;
+                    r.1 += 1;
+                }
             }
         }
     }
@@ -182,14 +191,14 @@ fn main() {
     println!("\n## Frame correspondence against a time-warped copy (warp strength 0.5): mean frame error\n");
     let frame_methods: Vec<String> = SETTINGS
         .iter()
-        .flat_map(|(t, l)| [format!("DIFT t{t} l{l}"), format!("centred t{t} l{l}")])
+        .flat_map(|(t, l)| [format!("joint mean t{t} l{l}"), format!("joints side by side t{t} l{l}")])
         .chain(["raw features".into(), "no matching (k -> k)".into()])
         .collect();
-    println!("| clips | {} |", frame_methods.join(" | "));
-    println!("|---|{}", "---|".repeat(frame_methods.len()));
-    for (set, row) in &frames {
+    println!("| clips | matching | {} |", frame_methods.join(" | "));
+    println!("|---|---|{}", "---|".repeat(frame_methods.len()));
+    for ((set, align), row) in &frames {
         let cells: Vec<String> = row.iter().map(|(s, n)| format!("{:.2}", s / (*n).max(1) as f64)).collect();
-        println!("| {set} (n = {}) | {} |", row[0].1, cells.join(" | "));
+        println!("| {set} (n = {}) | {align} | {} |", row[0].1, cells.join(" | "));
     }
     println!("\n## Extraction time per clip (one setting, {DRAWS} draws; median over settings is not taken: mean)\n");
     println!("| clip | frames | joints | seconds |");

@@ -23,12 +23,16 @@ _mo__dift() {
 
     case "${cmd}" in
         mo__dift)
-            opts="-o -q -v -h -V --joints --frames --as-binding --bind-rate --t --layer --draws --model --skeleton --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --joints --frames --align --as-binding --bind-rate --t --layer --draws --model --skeleton --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
+                --align)
+                    COMPREPLY=($(compgen -W "monotonic nearest" -- "${cur}"))
+                    return 0
+                    ;;
                 --bind-rate)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0

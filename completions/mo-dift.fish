@@ -1,3 +1,5 @@
+complete -c mo-dift -l align -d 'With --frames: how frames are matched' -r -f -a "monotonic\t'In time order (dynamic time warping): the answers never go back'
+nearest\t'Each target frame on its own: the most similar reference frame (the paper\'s rule)'"
 complete -c mo-dift -l bind-rate -d 'With --as-binding: binding rate 2 x pairs / (REF joints + TGT joints)' -r
 complete -c mo-dift -l t -d 'Diffusion step the motion is noised to (0..T-1) [default: joints 2, otherwise 3]' -r
 complete -c mo-dift -l layer -d 'Layer whose activations are read (0-based) [default: joints 0, otherwise 1]' -r

@@ -5,7 +5,7 @@ use crate::cli::load::{expand_inputs, is_dash, load_motions, LoadOptions, Loaded
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint::{self, Frozen};
 use crate::diffusion::Schedule;
-use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, Match};
+use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, monotonic_matches, Match};
 use crate::dift::{self, DiftFeatures, DiftOptions};
 use crate::io::{self, npy};
 use anyhow::{bail, Context};
@@ -37,9 +37,15 @@ EXAMPLES:
 /// the root, not leaves), most similar first, as many as --bind-rate asks for
 /// (Motion2Motion's rate, as --bind auto).
 ///
-/// --frames REF TGT: frame correspondence. Features averaged over joints, the best REF frame
-/// for every TGT frame, as JSON. Each noise draw places the clip at its own random temporal
-/// position, so that frames are not matched for sharing a position embedding.
+/// --frames REF TGT: frame correspondence, a REF frame for every TGT frame, as JSON. Frame
+/// descriptors are the joints' features side by side when REF and TGT share a skeleton (same
+/// joint names and parents), else the mean over joints (the paper's, across creatures). With
+/// --align monotonic (default) the answers never go back in time: dynamic time warping over
+/// the whole of both clips, for two takes of one action (a slower performance, a time-warped
+/// copy), where frame by frame a pose matches every cycle of a gait. --align nearest is the
+/// paper's frame-by-frame best match, for clips that do not share an order. Each noise draw
+/// places the clip at its own random temporal position, so that frames are not matched for
+/// sharing a position embedding.
 ///
 /// Defaults: joints t 2, layer 0; frames and plain features t 3, layer 1 (the paper's settings;
 /// see BENCHMARKS.md for accuracy on our models at other settings). AnyTop features drop a BVH's
@@ -59,6 +65,9 @@ pub struct Args {
     /// Frame correspondence between REF and TGT (JSON).
     #[arg(long)]
     pub frames: bool,
+    /// With --frames: how frames are matched.
+    #[arg(long, value_enum, value_name = "HOW", default_value_t = Align::Monotonic, requires = "frames")]
+    pub align: Align,
     /// With --joints: write a sparse binding REF -> TGT for mo-retarget --bind.
     #[arg(long, requires = "joints")]
     pub as_binding: bool,
@@ -82,6 +91,15 @@ pub struct Args {
     pub skeleton: Option<PathBuf>,
     #[command(flatten)]
     pub common: CommonOpts,
+}
+
+/// How `--frames` matches frames.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Align {
+    /// In time order (dynamic time warping): the answers never go back.
+    Monotonic,
+    /// Each target frame on its own: the most similar reference frame (the paper's rule).
+    Nearest,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -115,7 +133,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         bytes
     } else {
         let (reference, target) = (&motions[0], &motions[1]);
-        let header = serde_json::json!({
+        let mut header = serde_json::json!({
             "reference": reference.name, "target": target.name, "t": opts.t, "layer": opts.layer, "draws": opts.draws,
             "model": args.model.as_ref().map_or_else(|| "built-in".to_string(), |p| p.display().to_string()),
         });
@@ -135,7 +153,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
             }
         } else {
-            let rows: Vec<_> = best_matches(&cosine_matrix(&features[1].per_frame(), &features[0].per_frame()))
+            let same = same_skeleton(&reference.skeleton, &target.skeleton);
+            header["align"] = serde_json::json!(if args.align == Align::Monotonic { "monotonic" } else { "nearest" });
+            header["descriptors"] = serde_json::json!(if same { "joints side by side" } else { "mean over joints" });
+            let (r, t) = dift::frame_descriptors(&features[0], &features[1], same);
+            let sim = cosine_matrix(&t, &r);
+            let matches = match args.align {
+                Align::Monotonic => monotonic_matches(&sim),
+                Align::Nearest => best_matches(&sim),
+            };
+            let rows: Vec<_> = matches
                 .iter()
                 .map(|m| FrameRow { target: m.target, reference: m.reference, score: round(m.score), margin: round(m.margin) })
                 .collect();
@@ -144,6 +171,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         text.into_bytes()
     };
     io::write_output(args.common.output.as_deref(), &bytes).context("cannot write the output")
+}
+
+/// One skeleton in two files: the same joints (names and parents) in the same order; bone
+/// lengths may differ.
+fn same_skeleton(a: &crate::skeleton::Skeleton, b: &crate::skeleton::Skeleton) -> bool {
+    a.len() == b.len() && a.joints.iter().zip(&b.joints).all(|(x, y)| x.name == y.name && x.parent == y.parent)
 }
 
 /// DIFT features of one loaded motion.

@@ -48,6 +48,79 @@ pub fn best_matches(similarity: &[Vec<f64>]) -> Vec<Match> {
         .collect()
 }
 
+/// For every target row, a reference column such that the columns never go back in time:
+/// dynamic time warping on the cost 1 − similarity, from (0, 0) to (last, last) with steps
+/// (1, 0), (0, 1), (1, 1). Where the path crosses a target row over several columns, the most
+/// similar of them is that row's answer. `margin` is the answer's similarity minus the best
+/// other in its row: negative where the ordering overruled the frame-by-frame best.
+///
+/// Frame by frame (`best_matches`, the paper's rule) a pose matches any moment that looks
+/// alike: every cycle of a gait, the stand at either end of a clip. Two takes of one action —
+/// a time-warped copy, a slower performance — share their order, and the ordering constraint
+/// settles what the descriptors alone cannot (benches/dift.rs: time-warped clips).
+pub fn monotonic_matches(similarity: &[Vec<f64>]) -> Vec<Match> {
+    let rows = similarity.len();
+    let cols = similarity.first().map_or(0, Vec::len);
+    if rows == 0 || cols == 0 || similarity.iter().any(|r| r.len() != cols) {
+        return best_matches(similarity);
+    }
+    // Accumulated cost, one row at a time; the step taken into each cell for the way back
+    // (0 diagonal, 1 from the row above, 2 from the left), one byte per cell.
+    let cost = |t: usize, r: usize| 1.0 - similarity[t][r];
+    let mut step = vec![0u8; rows * cols];
+    let mut prev = vec![f64::INFINITY; cols];
+    let mut cur = vec![0.0; cols];
+    for t in 0..rows {
+        for r in 0..cols {
+            let (best, from) = if t == 0 && r == 0 {
+                (0.0, 0)
+            } else {
+                // Ties prefer the diagonal, then the row above: the path stays near k -> k
+                // when the descriptors cannot tell.
+                let diag = if t > 0 && r > 0 { prev[r - 1] } else { f64::INFINITY };
+                let up = if t > 0 { prev[r] } else { f64::INFINITY };
+                let left = if r > 0 { cur[r - 1] } else { f64::INFINITY };
+                if diag <= up && diag <= left {
+                    (diag, 0)
+                } else if up <= left {
+                    (up, 1)
+                } else {
+                    (left, 2)
+                }
+            };
+            cur[r] = best + cost(t, r);
+            step[t * cols + r] = from;
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    // Walk back, keeping per target row the most similar column the path crosses.
+    let mut answer = vec![usize::MAX; rows];
+    let (mut t, mut r) = (rows - 1, cols - 1);
+    loop {
+        if answer[t] == usize::MAX || similarity[t][r] > similarity[t][answer[t]] {
+            answer[t] = r;
+        }
+        if t == 0 && r == 0 {
+            break;
+        }
+        match step[t * cols + r] {
+            0 => (t, r) = (t - 1, r - 1),
+            1 => t -= 1,
+            _ => r -= 1,
+        }
+    }
+    answer
+        .iter()
+        .enumerate()
+        .map(|(target, &reference)| {
+            let row = &similarity[target];
+            let other = row.iter().enumerate().filter(|&(i, _)| i != reference).map(|(_, &s)| s).fold(f64::NEG_INFINITY, f64::max);
+            let margin = if other.is_finite() { row[reference] - other } else { 1.0 };
+            Match { target, reference, score: row[reference], margin }
+        })
+        .collect()
+}
+
 /// A sparse binding (reference = source, target = target) from a joint similarity matrix
 /// `[target][reference]`: only joints whose rotation moves a bone (not the root, not leaves,
 /// as `binding::auto`), only mutual best matches among them (each is the other's first
@@ -92,6 +165,27 @@ mod tests {
         assert!(m[0].score > 0.99 && m[0].margin > 0.9);
         // The zero descriptor is similar to nothing: a tie at 0, resolved to the first.
         assert_eq!((m[2].score, m[2].margin), (0.0, 0.0));
+    }
+
+    #[test]
+    fn monotonic_matches_follow_the_order_where_frames_look_alike() {
+        // A periodic descriptor (a gait: frame k looks like frame k + 10) and a target that is
+        // the reference played at half speed for its first half, then double speed.
+        let desc = |x: f64| vec![(x * std::f64::consts::TAU / 10.0).cos() as f32, (x * std::f64::consts::TAU / 10.0).sin() as f32, 0.3];
+        let reference: Vec<Vec<f32>> = (0..29).map(|k| desc(k as f64)).collect();
+        let truth: Vec<usize> = (0..30).map(|k| if k < 20 { k / 2 } else { 10 + (k - 20) * 2 }).collect();
+        let target: Vec<Vec<f32>> = truth.iter().map(|&x| desc(x as f64)).collect();
+        let sim = cosine_matrix(&target, &reference);
+        let nearest = best_matches(&sim);
+        assert!(nearest.iter().zip(&truth).any(|(m, &x)| m.reference != x), "frame by frame picks the wrong cycle");
+        let aligned = monotonic_matches(&sim);
+        assert_eq!(aligned.len(), truth.len());
+        assert!(aligned.windows(2).all(|w| w[1].reference >= w[0].reference));
+        assert_eq!((aligned[0].reference, aligned[29].reference), (0, 28));
+        let wrong = aligned.iter().zip(&truth).filter(|(m, &x)| m.reference.abs_diff(x) > 1).count();
+        assert!(wrong <= 2, "{wrong} frames off: {:?}", aligned.iter().map(|m| m.reference).collect::<Vec<_>>());
+        // A ragged matrix cannot be aligned; it falls back to frame by frame.
+        assert_eq!(monotonic_matches(&[vec![0.5, 0.9], vec![0.1]]).len(), 2);
     }
 
     #[test]

@@ -101,6 +101,36 @@ impl DiftFeatures {
             })
             .collect()
     }
+
+    /// One descriptor per motion frame: every joint's activations one after the other
+    /// (`joints x width` long). Finer than `per_frame` — which pose, not only how much the body
+    /// moves — but it compares only frames of one skeleton (same joints, same order).
+    pub fn per_frame_joints(&self) -> Vec<Vec<f32>> {
+        let per = self.joints * self.width;
+        (1..self.tokens).map(|t| self.data[t * per..(t + 1) * per].to_vec()).collect()
+    }
+}
+
+/// Frame descriptors of a reference and a target motion, comparable by cosine: each joint's
+/// activations side by side when both are of one skeleton (`same_skeleton`), else the mean over
+/// joints (AnyTop's, which works across creatures). Then centred on the mean frame of both
+/// clips together (what every frame shares would dominate the cosine; one mean for both, so a
+/// target that shows only part of the reference is not shifted against it). Measured on
+/// time-warped corpus clips (benches/dift.rs): the joint mean leaves poses ambiguous that the
+/// joints side by side tell apart.
+pub fn frame_descriptors(reference: &DiftFeatures, target: &DiftFeatures, same_skeleton: bool) -> (Vec<Vec<f32>>, Vec<Vec<f32>>) {
+    let (mut rows, split) = if same_skeleton && reference.joints == target.joints && reference.width == target.width {
+        let r = reference.per_frame_joints();
+        let n = r.len();
+        (r.into_iter().chain(target.per_frame_joints()).collect::<Vec<_>>(), n)
+    } else {
+        let r = reference.per_frame();
+        let n = r.len();
+        (r.into_iter().chain(target.per_frame()).collect(), n)
+    };
+    rows = centred(rows);
+    let target_rows = rows.split_off(split);
+    (rows, target_rows)
 }
 
 /// Each row minus the mean row: removes what every joint (or frame) shares — the timestep
