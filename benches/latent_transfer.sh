@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Zero-shot retargeting through the latent model (SATA) side by side with Motion2Motion on the
 # same pairs: human (LAFAN1 walk, held out of the corpus model) -> dog, dog -> human, flamingo ->
-# chicken. Scores both with `mo-metrics transfer` (frequency alignment and contact consistency
-# over the pairs of an automatic binding, the same pairs for both methods) and renders PNG
+# chicken. Scores both with `mo-metrics transfer` (frequency alignment, contact consistency and
+# motion ratio, over the pairs of an automatic binding, the same pairs for both methods) and renders PNG
 # sheets of source and results to look at.
 #
 #   cargo build --release && benches/latent_transfer.sh [MODEL_DIR ...]   # default: built-in
@@ -43,8 +43,8 @@ frames_from "$HUMAN" "$OUT/human.bvh" 150
 frames_from "$DOG" "$OUT/dog.bvh" 0
 cp "$FLAMINGO" "$OUT/flamingo.bvh"
 
-echo "| pair | method | model | frequency alignment | contact consistency | seconds |"
-echo "|---|---|---|---|---|---|"
+echo "| pair | method | model | frequency alignment | contact consistency | motion ratio | seconds |"
+echo "|---|---|---|---|---|---|---|"
 run_pair() { # name source target examples...
     local name=$1 src=$2 tgt=$3
     shift 3
@@ -71,9 +71,11 @@ report() { # name method model source result seconds
 import json, sys
 r = json.load(open(sys.argv[1]))
 row = r["results"][0] if "results" in r else r["per_result"][0]
-f = row["frequency_alignment"]; c = row["contact_consistency"]
-num = lambda v: v.get("value", v.get("mean", v)) if isinstance(v, dict) else v
-print(f"| {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {num(f)} | {num(c)} | {float(sys.argv[5]):.2f} |")
+f = row["frequency_alignment"]; c = row["contact_consistency"]; m = row["motion_ratio"]
+def num(v):
+    v = v.get("value", v.get("mean", v)) if isinstance(v, dict) else v
+    return f"{v:.3f}" if isinstance(v, float) else v
+print(f"| {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {num(f)} | {num(c)} | {num(m)} | {float(sys.argv[5]):.2f} |")
 PY
 }
 run_pair human_to_dog "$OUT/human.bvh" "$DOG_EX" "$DOG_EX"

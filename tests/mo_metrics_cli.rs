@@ -53,6 +53,8 @@ fn a_motion_against_itself_is_perfect() {
     assert!((freq - 1.0).abs() < 1e-9, "frequency alignment of a motion with itself: {freq}");
     let contact = num(&v, "results.0.contact_consistency.value");
     assert!((contact - 1.0).abs() < 1e-9, "contact consistency of a motion with itself: {contact}");
+    let motion = num(&v, "results.0.motion_ratio.value");
+    assert!((motion - 1.0).abs() < 1e-9, "motion ratio of a motion with itself: {motion}");
 
     let quad = example("quadruped.bvh");
     let v = json(

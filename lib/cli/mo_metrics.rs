@@ -371,7 +371,8 @@ fn run_transfer(
     for (l, c) in results.iter().zip(&clips) {
         let freq = transfer::frequency_alignment(&src_clip, c, &pairs).with_context(|| l.name.clone())?;
         let contact = transfer::contact_consistency(&src_clip, c, &pairs, &PhysicsOptions::default()).with_context(|| l.name.clone())?;
-        per_result.push(json!({ "file": l.name, "frequency_alignment": freq, "contact_consistency": contact }));
+        let motion = transfer::motion_ratio(&src_clip, c, &pairs).with_context(|| l.name.clone())?;
+        per_result.push(json!({ "file": l.name, "frequency_alignment": freq, "contact_consistency": contact, "motion_ratio": motion }));
     }
     let mut out = json!({
         "metric": "transfer",
@@ -419,6 +420,7 @@ fn run_transfer(
         units(&[
             ("frequency_alignment", "cosine similarity in [0, 1]"),
             ("contact_consistency", "fraction of frames in [0, 1]"),
+            ("motion_ratio", "result speed over source speed, each per skeleton size (1 = moves as much)"),
             ("diversity", "target length units"),
             ("throughput", "result frames per second"),
             ("fid_kinetic", "Fréchet distance of normalised features (dimensionless)"),

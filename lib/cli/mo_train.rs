@@ -86,6 +86,12 @@ pub struct Args {
     /// sata: weight of the KL term that keeps the latent near a unit Gaussian.
     #[arg(long, value_name = "W", default_value_t = 1e-4)]
     pub lambda_kl: f64,
+    /// sata: weight of the cross-skeleton latent cycle (a motion's latent decoded onto another
+    /// training skeleton and encoded again should come back; what makes decoding onto a
+    /// foreign skeleton move). Default 1 for a new run; a resumed run keeps its checkpoint's
+    /// unless this is given.
+    #[arg(long, value_name = "W")]
+    pub lambda_cycle: Option<f64>,
     /// Learning rate.
     #[arg(long, value_name = "LR", default_value_t = 1e-4)]
     pub lr: f64,
@@ -461,7 +467,7 @@ fn run_sata(args: &Args) -> anyhow::Result<()> {
             version: sata::checkpoint::VERSION,
             config: cfg,
             scale,
-            weights: LossWeights { kl: args.lambda_kl, ..LossWeights::default() },
+            weights: LossWeights { kl: args.lambda_kl, cycle: args.lambda_cycle.unwrap_or(1.0), ..LossWeights::default() },
             step: 0,
             seed: args.common.seed,
             lr: args.lr,
@@ -473,6 +479,9 @@ fn run_sata(args: &Args) -> anyhow::Result<()> {
         (varmap, model, AdamW::new(args.lr), info, set)
     };
     info.skeletons = set.skeletons.iter().map(|s| s.name.clone()).collect();
+    if let Some(w) = args.lambda_cycle {
+        info.weights.cycle = w;
+    }
     let first = info.step;
     let vars = named_vars(&varmap);
     let mut trainer = SataTrainer { args, info, varmap, model, vars, opt, set, device };
@@ -495,8 +504,8 @@ impl Trainer for SataTrainer<'_> {
         let mut rng = step_rng(self.info.seed, k);
         let l = sata::train::train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.info.scale, &self.info.weights, &mut rng, self.args.batch as usize, &self.device)?;
         let extra = format!(
-            ",\"reconstruction\":{},\"root\":{},\"geodesic\":{},\"smooth\":{},\"contact\":{},\"penetration\":{},\"kl\":{}",
-            l.reconstruction, l.root, l.geodesic, l.smooth, l.contact, l.penetration, l.kl
+            ",\"reconstruction\":{},\"root\":{},\"geodesic\":{},\"smooth\":{},\"contact\":{},\"penetration\":{},\"kl\":{},\"cycle\":{}",
+            l.reconstruction, l.root, l.geodesic, l.smooth, l.contact, l.penetration, l.kl, l.cycle
         );
         Ok((l.total, extra))
     }

@@ -195,6 +195,48 @@ pub fn contact_consistency(
     }))
 }
 
+/// Motion ratio: how much the result moves next to its source, per bound pair the RMS speed of
+/// the result joint over that of the source joint (mean velocity removed, as in frequency
+/// alignment, and each divided by its skeleton's size, so a mouse and a dinosaur doing the
+/// same motion score 1). Frequency alignment and contact consistency cannot tell a result
+/// that barely moves from one that moves fully in the same rhythm; this can.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct MotionRatio {
+    /// Median over the pairs whose source joint moves.
+    pub value: f64,
+    /// One ratio per such pair (source joint, result joint).
+    pub pairs: Vec<(usize, usize)>,
+    pub per_pair: Vec<f64>,
+}
+
+/// [`MotionRatio`]; `NotApplicable` when no bound source joint moves. Needs 2 frames per clip.
+pub fn motion_ratio(source: &Clip, result: &Clip, pairs: &[(usize, usize)]) -> Result<Maybe<MotionRatio>, MetricError> {
+    check_clip(source, 2, "motion ratio (source)")?;
+    check_clip(result, 2, "motion ratio (result)")?;
+    check_pairs(source, result, pairs, "motion ratio")?;
+    let speed = |clip: &Clip, j: usize| -> f64 {
+        let v = velocities(clip, j);
+        (v.iter().map(|x| x.length_squared()).sum::<f64>() / v.len() as f64).sqrt() / clip.scale.max(1e-12)
+    };
+    let (mut counted, mut per_pair) = (Vec::new(), Vec::new());
+    for &(s, r) in pairs {
+        let a = speed(source, s);
+        // Relative floor: FK rounding on a still joint, not motion.
+        if a > 1e-9 {
+            counted.push((s, r));
+            per_pair.push(speed(result, r) / a);
+        }
+    }
+    if counted.is_empty() {
+        return Ok(Maybe::NotApplicable("no bound source joint moves".into()));
+    }
+    let mut sorted = per_pair.clone();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    let value = if n % 2 == 1 { sorted[n / 2] } else { 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]) };
+    Ok(Maybe::Value(MotionRatio { value, pairs: counted, per_pair }))
+}
+
 /// Transfer diversity: mean over pairs of samples of the mean distance between corresponding
 /// joints over all frames (clip units; normalised by the first sample's scale). Samples must
 /// share joints and frame count; fewer than 2 samples is `TooLittle`.
@@ -260,6 +302,21 @@ mod tests {
         let still = sway(50, 30.0, 1.0, 0.0);
         assert_eq!(frequency_alignment(&still, &still, &[(1, 1)]).unwrap().value, 1.0);
         assert_eq!(frequency_alignment(&still, &a, &[(1, 1)]).unwrap().value, 0.0);
+    }
+
+    #[test]
+    fn motion_ratio_tells_a_result_that_barely_moves() {
+        let a = sway(120, 30.0, 1.5, 0.2);
+        let Maybe::Value(same) = motion_ratio(&a, &a, &[(0, 0), (1, 1)]).unwrap() else { panic!("a moving source") };
+        assert!((same.value - 1.0).abs() < 1e-12, "{same:?}");
+        // The same rhythm at a tenth of the amplitude: frequency alignment cannot see it.
+        let faint = sway(120, 30.0, 1.5, 0.02);
+        assert!(frequency_alignment(&a, &faint, &[(1, 1)]).unwrap().value > 0.99);
+        let Maybe::Value(r) = motion_ratio(&a, &faint, &[(1, 1)]).unwrap() else { panic!("a moving source") };
+        assert!((r.value - 0.1).abs() < 1e-9, "{r:?}");
+        let still = sway(50, 30.0, 1.0, 0.0);
+        assert!(matches!(motion_ratio(&still, &a, &[(1, 1)]).unwrap(), Maybe::NotApplicable(_)));
+        assert!(matches!(motion_ratio(&a, &a, &[(0, 9)]), Err(MetricError::Mismatch(_))));
     }
 
     #[test]

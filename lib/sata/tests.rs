@@ -2,7 +2,7 @@
 //! trained, a tiny model learning to reconstruct one clip.
 
 use super::graph::{depths, reverse_depths, SkeletonGraph};
-use super::train::{loss, FeatureScale, LossWeights};
+use super::train::{cycle_loss, loss, FeatureScale, LossWeights};
 use super::{SataConfig, SataModel};
 use crate::diffusion::train::named_vars;
 use crate::document::AnyTopSection;
@@ -116,4 +116,34 @@ fn feature_scale_divides_by_group_rms_and_undoes_exactly() {
     assert!(worst < 1e-5, "apply + undo changed a value by {worst}");
     let bad = FeatureScale { root: vec![0.0; 13], joint: scale.joint.clone() };
     assert!(bad.check().is_err());
+}
+
+#[test]
+fn the_latent_cycle_reaches_decoder_and_encoder_and_can_be_learned() {
+    let varmap = VarMap::new();
+    let model = SataModel::new(seeded_var_builder(&varmap, 11, &Device::Cpu), &SataConfig::tiny()).unwrap();
+    let (_, dog, dog_f) = clip("quadruped");
+    let (_, crab, crab_f) = clip("crab");
+    let scale = FeatureScale::measure([(&dog_f, dog.rest.as_slice()), (&crab_f, crab.rest.as_slice())]);
+    let x = tensor(&dog_f, 12, &scale, &dog);
+    let s = scale.tensor(crab.joints, &Device::Cpu).unwrap();
+    let vars = named_vars(&varmap);
+    let cycle = |model: &SataModel| {
+        let (mu, _) = model.encode(&x, &dog).unwrap();
+        cycle_loss(model, &mu, &crab, &s).unwrap()
+    };
+    let c = cycle(&model);
+    let first = c.to_scalar::<f32>().unwrap();
+    assert!(first.is_finite() && first > 0.0, "cycle loss {first}");
+    let grads = c.backward().unwrap();
+    let moved = |prefix: &str| {
+        vars.iter().filter(|(n, _)| n.starts_with(prefix)).any(|(_, v)| grads.get(v.as_tensor()).is_some_and(|g| g.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap() > 0.0))
+    };
+    assert!(moved("decoder.output") && moved("decoder.modulation") && moved("encoder.input"), "the cycle must train both halves");
+    let mut opt = crate::diffusion::train::AdamW::new(3e-3);
+    for _ in 0..40 {
+        opt.update(&vars, &cycle(&model).backward().unwrap()).unwrap();
+    }
+    let last = cycle(&model).to_scalar::<f32>().unwrap();
+    assert!(last < first * 0.5, "cycle loss {first} -> {last}");
 }
