@@ -81,6 +81,24 @@ fn edits_keep_the_reference_and_generate_the_rest() {
     let p95 = report["reference_jumps"]["p95"].as_f64().unwrap();
     assert!(p95 > 0.0 && p95 <= report["reference_jumps"]["max"].as_f64().unwrap());
 
+    // The default smoothing and blend: against the raw model output (--smooth 0) the same
+    // samples keep the kept frames and meet them far more gently (a 2-step model's raw frames
+    // are noise).
+    let mut raw_args = base("3");
+    raw_args.extend(["--keep-frames", "0-4,15-19", "--report", "--smooth", "0"]);
+    let raw = run("mo-sample", &raw_args, None);
+    ok(&raw, "raw in-betweening");
+    let raw_report: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&raw.stderr).trim()).unwrap();
+    let seam_sum = |r: &serde_json::Value| -> f64 {
+        r["samples"].as_array().unwrap().iter().flat_map(|x| x["seams"].as_array().unwrap().iter().map(|s| s["jump"].as_f64().unwrap())).sum()
+    };
+    let (smoothed, unsmoothed) = (seam_sum(&report), seam_sum(&raw_report));
+    assert!(smoothed < 0.5 * unsmoothed, "seam jumps: {smoothed} smoothed vs {unsmoothed} raw");
+    for (sample, raw) in got.iter().zip(samples(&raw.stdout)) {
+        assert_eq!(sample.data[..5 * j * 13], raw.data[..5 * j * 13], "kept frames are the same either way");
+        assert_ne!(sample.data[5 * j * 13..15 * j * 13], raw.data[5 * j * 13..15 * j * 13], "the middle is smoothed");
+    }
+
     // Body-part editing with DDIM: the legs (thighs and below) are the reference's in every frame.
     let mut args = base("3");
     args.extend(["--sampler", "ddim", "--keep-joints", "*Thigh/"]);
@@ -121,7 +139,10 @@ fn bad_edits_exit_2_without_output() {
         a.extend(extra);
         run("mo-sample", &a, None)
     };
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 9] = [
+        (&["--smooth", "1000"], "below half the frame rate"),
+        (&["--smooth=-1"], "--smooth must be a cutoff in Hz"),
+        (&["--blend=-0.5"], "--blend must be a duration"),
         (&["--reference", s(&quad), "--keep-frames", "0-4,18-25"], "past the last frame"),
         (&["--reference", s(&quad), "--keep-frames", "4-2"], "ends (2) before it starts (4)"),
         (&["--reference", s(&quad), "--keep-joints", "Bip01_L_Thihg"], "Bip01_L_Thigh"),

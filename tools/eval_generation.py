@@ -72,8 +72,11 @@ def sample(bindir, model, skeleton, out, n, frames, steps, sampler, seed):
     os.makedirs(out)
     cmd = [f"{bindir}/mo-sample", skeleton, "-n", str(n), "--frames", str(frames), "--seed", str(seed), "-q",
            "--steps", str(steps), "--sampler", sampler, "--bvh", os.path.join(out, "sample_{i}.bvh")]
-    if model != "builtin":
-        cmd += ["--model", model]
+    # A model spec is a directory (or 'builtin') and optionally more mo-sample options after it.
+    where, *extra = model.split()
+    if where != "builtin":
+        cmd += ["--model", where]
+    cmd += extra
     t = time.monotonic()
     run(cmd)
     return time.monotonic() - t
@@ -86,7 +89,7 @@ def row(cells):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default="target/release")
-    ap.add_argument("--model", action="append", default=[], metavar="NAME=DIR", help="'builtin' as DIR = the embedded model")
+    ap.add_argument("--model", action="append", default=[], metavar="NAME=DIR", help="'builtin' as DIR = the embedded model; mo-sample options may follow DIR, e.g. 'raw=builtin --smooth 0'")
     ap.add_argument("--skeletons", nargs="+", required=True, metavar="FOLDER")
     ap.add_argument("-n", type=int, default=8)
     ap.add_argument("--frames", type=int, default=120)

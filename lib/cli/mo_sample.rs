@@ -9,6 +9,7 @@ use crate::diffusion::sample::{sample, SampleOptions};
 use crate::diffusion::{Sampler, Schedule};
 use crate::io::{self, npy};
 use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
+use crate::repr::smooth::{lambda_for_cutoff, smooth_features};
 use crate::repr::Features;
 use crate::bvh;
 use anyhow::{bail, Context};
@@ -24,6 +25,14 @@ EXAMPLES:
     mo-sample examples/data/quadruped.bvh --model model --frames 40 --steps 5 --bvh q.bvh
     mo-sample --reference q.bvh --model model --steps 5 --keep-frames 0-9,30-38 --report > ib.npy
     mo-sample --reference q.bvh --model model --steps 5 --keep-joints '*Thigh/' --bvh legs.bvh";
+
+/// The default `--smooth`: 4 Hz, above the step frequency of a gait (1-2 Hz) and below the
+/// model's frame-to-frame jitter; measured against 3 and 6 Hz and the raw output in
+/// models/zoo-small/MODEL_CARD.md (at 6 Hz jerk stays up to 60x the clips').
+pub const DEFAULT_SMOOTH_HZ: f64 = 4.0;
+
+/// The default `--blend`: half a second (15 frames at 30 fps), the order of a step.
+pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 
 /// Generate motion for a skeleton with a trained diffusion model (AnyTop).
 ///
@@ -52,6 +61,13 @@ EXAMPLES:
 /// the reference's length (its BVH frames minus one: AnyTop features drop the last frame)
 /// unless --frames or --seconds says otherwise; frames past the reference's end are generated.
 /// BVH output stands where the reference stood.
+///
+/// Smoothing: the model's raw frames jitter (mean jerk 10-370x the training clips' for the
+/// built-in model), so the output is low-passed over time, --smooth HZ being where motion keeps
+/// half its amplitude (a Whittaker smoother; slow motion passes, straight lines exactly). Kept
+/// frames and joints stay exact; generated frames next to kept ones give way to them over
+/// --blend seconds, so a transition continues the kept motion with its velocity instead of
+/// jumping. --smooth 0 gives the model's raw output.
 ///
 /// --report prints one JSON line on stderr: per sample, the velocity jump at every seam
 /// between kept and generated frames (mean over joints of the largest change of a joint's
@@ -100,6 +116,14 @@ pub struct Args {
     /// Print seam continuity as one JSON line on stderr (with --reference).
     #[arg(long, requires = "reference")]
     pub report: bool,
+    /// Low-pass the generated frames over time: the cutoff in Hz where motion keeps half its
+    /// amplitude (kept frames and joints stay exact; 0 = the model's raw output).
+    #[arg(long, value_name = "HZ", default_value_t = DEFAULT_SMOOTH_HZ)]
+    pub smooth: f64,
+    /// Editing with --smooth: generated frames next to kept ones give way to them over this
+    /// many seconds, continuing the kept motion instead of jumping to the generated one.
+    #[arg(long, value_name = "S", default_value_t = DEFAULT_BLEND_SECONDS)]
+    pub blend: f64,
     #[command(flatten)]
     pub common: CommonOpts,
 }
@@ -168,10 +192,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         SamplerArg::Ddpm => Sampler::Ddpm,
         SamplerArg::Ddim => Sampler::Ddim,
     };
+    let lambda = smoothing(args.smooth, fps)?;
+    if !(args.blend.is_finite() && args.blend >= 0.0) {
+        bail!("--blend must be a duration in seconds (>= 0), found {}", args.blend);
+    }
+    let blend = (args.blend * fps).round() as usize;
     let schedule = Schedule::cosine(loaded.info.schedule_steps);
     let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler, seed: args.common.seed };
     let started = std::time::Instant::now();
-    let samples = match (&reference, &mask) {
+    let mut samples = match (&reference, &mask) {
         (Some(r), Some(mask)) => {
             // Frames past the reference's end are generated; their reference values are unused.
             let mut padded = r.features.clone();
@@ -183,6 +212,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
     };
+    if let Some(lambda) = lambda {
+        for f in &mut samples {
+            smooth_features(f, lambda, mask.as_ref().map(|m| m.keep.as_slice()), blend);
+        }
+    }
     if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {
         eprintln!("{}", seam_report(&section.rig, skeleton, r, mask, &samples)?);
     }
@@ -215,6 +249,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The smoother's weight for `--smooth HZ` at `fps`; `None` for 0 (raw output).
+fn smoothing(hz: f64, fps: f64) -> anyhow::Result<Option<f64>> {
+    if hz == 0.0 {
+        return Ok(None);
+    }
+    if !hz.is_finite() || hz < 0.0 {
+        bail!("--smooth must be a cutoff in Hz (>= 0; 0 = no smoothing), found {hz}");
+    }
+    match lambda_for_cutoff(hz, fps) {
+        Some(lambda) => Ok(Some(lambda)),
+        None => bail!("--smooth {hz}: the cutoff must be below half the frame rate ({:.1} Hz at {fps:.1} fps); 0 = no smoothing", fps / 2.0),
+    }
 }
 
 /// Read and encode `--reference` on the rig of the skeleton being sampled.

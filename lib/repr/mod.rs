@@ -7,6 +7,7 @@
 
 pub mod anytop;
 pub mod m2m;
+pub mod smooth;
 /// A `[frames, joints, dims]` float32 tensor, row-major (dims fastest).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Features {
