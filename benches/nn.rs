@@ -12,8 +12,8 @@
 //! Measured here (2 shared cores), before the fused kernels (`lib/nn/fused.rs`): the time went
 //! to element-wise passes over the J x J and T x T attention maps and to fresh allocations
 //! (page faults, memset). glibc returning large blocks to the OS cost a lot; `mo-train` and
-//! `mo-sample` call `nn::keep_freed_memory` (mallopt), this bench does not. Current numbers:
-//! BENCHMARKS.md.
+//! `mo-sample` call `nn::keep_freed_memory` (mallopt), and so does this bench unless
+//! NN_BENCH_GLIBC_DEFAULTS is set. Current numbers: BENCHMARKS.md.
 
 mod common;
 use common::{median, ms, time_runs};
@@ -85,6 +85,14 @@ fn forward_flops(cfg: &DenoiserConfig, b: usize, t: usize, j: usize) -> f64 {
 }
 
 fn main() {
+    // As mo-train and mo-sample run the model (NN_BENCH_GLIBC_DEFAULTS=1: glibc's defaults, which
+    // add page faults and kernel zeroing to every step).
+    let tuned = std::env::var_os("NN_BENCH_GLIBC_DEFAULTS").is_none();
+    if tuned {
+        menagerie::nn::keep_freed_memory();
+    }
+    println!("allocator: {}", if tuned { "freed memory kept (as mo-train)" } else { "glibc defaults" });
+    println!();
     println!("| matmul n x n (f32, candle CPU, gemm x86-v4) | GFLOP/s |");
     println!("|---|---|");
     let mut peak: f64 = 0.0;
