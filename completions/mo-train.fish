@@ -8,7 +8,7 @@ complete -c mo-train -l crop -d 'Crop length in frames (default 40 for anytop; f
 complete -c mo-train -l arch -d 'What to train: anytop (the diffusion model behind mo-sample, mo-dift and mo-segment) or sata (the topology-agnostic autoencoder behind mo-encode --latent and mo-retarget --method latent)' -r -f -a "anytop\t''
 sata\t''"
 complete -c mo-train -l lambda-kl -d 'sata: weight of the KL term that keeps the latent near a unit Gaussian' -r
-complete -c mo-train -l lambda-cycle -d 'sata: weight of the cross-skeleton latent cycle (a motion\'s latent decoded onto another training skeleton and encoded again should come back; what makes decoding onto a foreign skeleton move). Default 1 for a new run; a resumed run keeps its checkpoint\'s unless this is given' -r
+complete -c mo-train -l lambda-cycle -d 'sata: weight of the cross-skeleton latent cycle (a motion\'s latent decoded onto another training skeleton and encoded again should come back). Default 0 for a new run (tried at 1 for 1,100 steps: transfers moved less, models/zoo-sata/MODEL_CARD.md); a resumed run keeps its checkpoint\'s unless this is given' -r
 complete -c mo-train -l lr -d 'Learning rate' -r
 complete -c mo-train -l lambda-geo -d 'Weight of the geodesic rotation loss (the angle, in radians, between predicted and true joint rotations) next to the MSE; the reference trains with 1' -r
 complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3' -r

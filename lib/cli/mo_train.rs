@@ -87,9 +87,9 @@ pub struct Args {
     #[arg(long, value_name = "W", default_value_t = 1e-4)]
     pub lambda_kl: f64,
     /// sata: weight of the cross-skeleton latent cycle (a motion's latent decoded onto another
-    /// training skeleton and encoded again should come back; what makes decoding onto a
-    /// foreign skeleton move). Default 1 for a new run; a resumed run keeps its checkpoint's
-    /// unless this is given.
+    /// training skeleton and encoded again should come back). Default 0 for a new run (tried
+    /// at 1 for 1,100 steps: transfers moved less, models/zoo-sata/MODEL_CARD.md); a resumed
+    /// run keeps its checkpoint's unless this is given.
     #[arg(long, value_name = "W")]
     pub lambda_cycle: Option<f64>,
     /// Learning rate.
@@ -467,7 +467,7 @@ fn run_sata(args: &Args) -> anyhow::Result<()> {
             version: sata::checkpoint::VERSION,
             config: cfg,
             scale,
-            weights: LossWeights { kl: args.lambda_kl, cycle: args.lambda_cycle.unwrap_or(1.0), ..LossWeights::default() },
+            weights: LossWeights { kl: args.lambda_kl, cycle: args.lambda_cycle.unwrap_or(0.0), ..LossWeights::default() },
             step: 0,
             seed: args.common.seed,
             lr: args.lr,
