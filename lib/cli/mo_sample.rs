@@ -62,7 +62,7 @@ pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 /// unless --frames or --seconds says otherwise; frames past the reference's end are generated.
 /// BVH output stands where the reference stood.
 ///
-/// Smoothing: the model's raw frames jitter (mean jerk 10-370x the training clips' for the
+/// Smoothing: the model's raw frames jitter (mean jerk 6-370x the training clips' for the
 /// built-in model), so the output is low-passed over time, --smooth HZ being where motion keeps
 /// half its amplitude (a Whittaker smoother; slow motion passes, straight lines exactly). Kept
 /// frames and joints stay exact; generated frames next to kept ones give way to them over
