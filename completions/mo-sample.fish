@@ -15,6 +15,7 @@ complete -c mo-sample -s o -l output -d 'Write output here instead of stdout (\'
 complete -c mo-sample -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-sample -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
 complete -c mo-sample -l report -d 'Print seam continuity as one JSON line on stderr (with --reference)'
+complete -c mo-sample -l no-plant-feet -d 'Keep the model\'s root travel even where it makes planted feet slide (by default the root\'s horizontal motion follows the feet the model puts on the ground)'
 complete -c mo-sample -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-sample -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-sample -s h -l help -d 'Print help (see more with \'--help\')'

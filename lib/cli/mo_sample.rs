@@ -8,7 +8,7 @@ use crate::diffusion::edit::{self, KeepMask};
 use crate::diffusion::sample::{sample, SampleOptions};
 use crate::diffusion::{Sampler, Schedule};
 use crate::io::{self, npy};
-use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
+use crate::repr::anytop::{plant_feet, IkOptions, FEATURE_DIMS};
 use crate::repr::smooth::{lambda_for_cutoff, smooth_features};
 use crate::repr::Features;
 use crate::bvh;
@@ -124,6 +124,10 @@ pub struct Args {
     /// many seconds, continuing the kept motion instead of jumping to the generated one.
     #[arg(long, value_name = "S", default_value_t = DEFAULT_BLEND_SECONDS)]
     pub blend: f64,
+    /// Keep the model's root travel even where it makes planted feet slide (by default the
+    /// root's horizontal motion follows the feet the model puts on the ground).
+    #[arg(long)]
+    pub no_plant_feet: bool,
     #[command(flatten)]
     pub common: CommonOpts,
 }
@@ -212,9 +216,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
     };
-    if let Some(lambda) = lambda {
-        for f in &mut samples {
-            smooth_features(f, lambda, mask.as_ref().map(|m| m.keep.as_slice()), blend);
+    let fixed = mask.as_ref().map(|m| m.keep.as_slice());
+    for f in &mut samples {
+        if let Some(lambda) = lambda {
+            smooth_features(f, lambda, fixed, blend);
+        }
+        if !args.no_plant_feet {
+            plant_feet(f, &section.rig.feet, fixed);
+            if let Some(lambda) = lambda {
+                // Planting switches the root's velocity where feet land and lift: smooth the
+                // root again (its cells only), so that no jump is left where the set changes.
+                let joints = f.joints;
+                let others: Vec<bool> = (0..f.frames * joints).map(|k| k % joints != 0 || fixed.is_some_and(|m| m[k])).collect();
+                smooth_features(f, lambda, Some(&others), blend);
+            }
         }
     }
     if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {

@@ -100,7 +100,7 @@ fn slot_rotation(prep: &Prepared, features: &Features, t: usize, j: usize) -> DQ
 
 /// The heading encoded in a root 6D, as the yaw it is (the encoder writes pure yaws; anything
 /// else is projected onto one).
-fn root_yaw(v: [f64; 6]) -> DQuat {
+pub(super) fn root_yaw(v: [f64; 6]) -> DQuat {
     let a = DVec3::new(v[0], v[1], v[2]);
     let b = DVec3::new(v[3], v[4], v[5]);
     // R = R_y(θ) has third column (sin θ, 0, cos θ) and first column (cos θ, 0, −sin θ).

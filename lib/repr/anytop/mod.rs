@@ -115,10 +115,12 @@
 mod decode;
 mod encode;
 mod ik;
+mod plant;
 mod rig;
 mod stats;
 
 pub use ik::IkOptions;
+pub use plant::plant_feet;
 pub use rig::AnyTopRig;
 pub use stats::AnyTopStats;
 
