@@ -81,7 +81,7 @@ struct Attention {
     saved: Option<std::sync::Mutex<Vec<f32>>>,
 }
 
-fn f32_slice<'a>(s: &'a CpuStorage, l: &Layout, what: &str) -> Result<&'a [f32]> {
+pub(super) fn f32_slice<'a>(s: &'a CpuStorage, l: &Layout, what: &str) -> Result<&'a [f32]> {
     let CpuStorage::F32(data) = s else {
         candle_core::bail!("{what}: fused kernels take f32 tensors");
     };
@@ -124,93 +124,97 @@ impl Attention {
         }
     }
 
-    /// Gathers group `g`'s head `h` into `s`: queries (pre-scaled), keys, keys transposed and
-    /// values, each `len x dh` (transposed: `dh x len`), so the loops below run over
-    /// contiguous memory.
-    #[inline(always)]
-    fn gather(&self, qkv: &[f32], h: usize, s: &mut Scratch) {
-        let (n, dh, w) = (self.groups.len, self.head_dim, self.width());
-        for i in 0..n {
-            let r = s.rows[i] * 3 * w + h * dh;
-            for e in 0..dh {
-                s.q[i * dh + e] = qkv[r + e] * self.scale;
-                let k = qkv[r + w + e];
-                s.k[i * dh + e] = k;
-                s.kt[e * n + i] = k;
-                let v = qkv[r + 2 * w + e];
-                s.v[i * dh + e] = v;
-                s.vt[e * n + i] = v;
-            }
+    /// Query blocks `(i0, i1)` with the key range `klo..khi` their spans cover (key 0 comes on
+    /// top when `klo > 0`). Skeletal attention is one block; the temporal window is cut into
+    /// blocks so a 120-frame sample does not multiply 120 x 120 logits of which 31 per row count.
+    fn blocks(&self) -> Vec<(usize, usize, usize, usize)> {
+        let n = self.groups.len;
+        match &self.keys {
+            Keys::Topology { .. } => vec![(0, n, 0, n)],
+            Keys::Window { half, .. } => (0..n)
+                .step_by(QUERY_BLOCK)
+                .map(|i0| {
+                    let i1 = (i0 + QUERY_BLOCK).min(n);
+                    (i0, i1, i0.saturating_sub(*half), (i1 + half).min(n))
+                })
+                .collect(),
         }
     }
 
-    /// Attention probabilities of the gathered group (`g`, head `h`) into `s.p` (`len x len`,
-    /// row = query; invisible keys 0). A query without any visible key (never the case for our
-    /// masks) gets a zero row.
+    /// Where head `h` of group `g`'s queries, keys and values are in the `[rows, 3w]` q/k/v
+    /// matrix (and its gradient), and its output in `[rows, w]`: `(q, k, v, out)`.
+    fn views(&self, g: usize, h: usize) -> (Strided, Strided, Strided, Strided) {
+        let (w, dh) = (self.width(), self.head_dim);
+        let (base, ps) = (self.groups.row(g, 0), self.groups.pos_stride);
+        let q = Strided { off: base * 3 * w + h * dh, rs: ps * 3 * w, cs: 1 };
+        (q, Strided { off: q.off + w, ..q }, Strided { off: q.off + 2 * w, ..q }, Strided { off: base * w + h * dh, rs: ps * w, cs: 1 })
+    }
+
+    /// Attention probabilities of group `g`, head `h` into `p` (`len x len`, row = query):
+    /// logits of each block as one small GEMM, then bias, masks and softmax per row. Columns a
+    /// query cannot see are 0; columns outside its block's key range are not touched.
     #[inline(always)]
-    fn probabilities(&self, c: Option<&[f32]>, g: usize, h: usize, s: &mut Scratch) {
+    fn probabilities(&self, qkv: &[f32], c: Option<&[f32]>, g: usize, h: usize, p: &mut [f32]) {
         let (n, dh) = (self.groups.len, self.head_dim);
         let sample = g / self.groups.per_sample;
-        for i in 0..n {
-            let (lo, hi) = self.span(i);
-            let row = &mut s.p[i * n..(i + 1) * n];
-            row.fill(0.0);
-            // Logits q_i·k over the span: one axpy per head dimension (vectorises over keys).
-            for e in 0..dh {
-                let qe = s.q[i * dh + e];
-                let kt = &s.kt[e * n..(e + 1) * n];
-                row[lo..hi].iter_mut().zip(&kt[lo..hi]).for_each(|(o, k)| *o += qe * k);
+        let (q, k, _, _) = self.views(g, h);
+        let mut coefficients: Vec<f32> = Vec::new();
+        for (i0, i1, klo, khi) in self.blocks() {
+            let pm = Strided { off: i0 * n + klo, rs: n, cs: 1 };
+            small_gemm(p, pm, qkv, q.at(i0, 0), qkv, k.at(klo, 0).t(), (i1 - i0, khi - klo, dh), self.scale, false);
+            for i in i0..i1 {
+                let row = &mut p[i * n..(i + 1) * n];
+                if klo > 0 {
+                    let (qi, k0) = (q.at(i, 0).off, k.off);
+                    row[0] = self.scale * (0..dh).map(|e| qkv[qi + e] * qkv[k0 + e]).sum::<f32>();
+                }
+                let (lo, hi) = self.span(i);
+                match &self.keys {
+                    Keys::Topology { types, key_ok, type_count } => {
+                        // This query's coefficients with a 0 appended for NO_TYPE, so the loop
+                        // below has no branches but the key mask.
+                        let at = (self.groups.row(g, i) * self.heads + h) * type_count;
+                        coefficients.clear();
+                        coefficients.extend_from_slice(c.map_or(&[][..], |c| &c[at..at + type_count]));
+                        coefficients.resize(type_count + 1, 0.0);
+                        let none = *type_count;
+                        let keys_ok = &key_ok[sample * n..(sample + 1) * n];
+                        let pair_types = &types[(sample * n + i) * n..(sample * n + i + 1) * n];
+                        for ((v, &ok), &[a, b]) in row.iter_mut().zip(keys_ok).zip(pair_types) {
+                            let (a, b) = ((a as usize).min(none), (b as usize).min(none));
+                            let biased = *v + coefficients[a] + coefficients[b];
+                            *v = if ok { biased } else { f32::NEG_INFINITY };
+                        }
+                    }
+                    Keys::Window { frame_ok, .. } => {
+                        let tokens_ok = &frame_ok[sample * n..(sample + 1) * n];
+                        for k in (lo..hi).chain((lo > 0).then_some(0)) {
+                            if !tokens_ok[k] {
+                                row[k] = f32::NEG_INFINITY;
+                            }
+                        }
+                        // Outside the window but inside the block's key range: invisible.
+                        row[klo.max(1).min(lo)..lo].fill(0.0);
+                        row[hi..khi].fill(0.0);
+                    }
+                }
+                let max = max(&row[lo..hi]).max(if lo > 0 { row[0] } else { f32::NEG_INFINITY });
+                if max == f32::NEG_INFINITY {
+                    row[klo..khi].fill(0.0);
+                    row[0] = 0.0;
+                    continue;
+                }
+                row[lo..hi].iter_mut().for_each(|v| *v = exp(*v - max));
+                let mut sum = sum(&row[lo..hi]);
                 if lo > 0 {
-                    row[0] += qe * kt[0];
+                    row[0] = exp(row[0] - max);
+                    sum += row[0];
                 }
-            }
-            match &self.keys {
-                Keys::Topology { types, key_ok, type_count } => {
-                    let at = (s.rows[i] * self.heads + h) * type_count;
-                    let keys_ok = &key_ok[sample * n..(sample + 1) * n];
-                    let pair_types = &types[(sample * n + i) * n..(sample * n + i + 1) * n];
-                    for ((v, &ok), &[a, b]) in row.iter_mut().zip(keys_ok).zip(pair_types) {
-                        if !ok {
-                            *v = f32::NEG_INFINITY;
-                            continue;
-                        }
-                        if let Some(c) = c {
-                            if a != NO_TYPE {
-                                *v += c[at + a as usize];
-                            }
-                            if b != NO_TYPE {
-                                *v += c[at + b as usize];
-                            }
-                        }
-                    }
+                let inv = 1.0 / sum;
+                row[lo..hi].iter_mut().for_each(|v| *v *= inv);
+                if lo > 0 {
+                    row[0] *= inv;
                 }
-                Keys::Window { frame_ok, .. } => {
-                    let tokens_ok = &frame_ok[sample * n..(sample + 1) * n];
-                    for k in (lo..hi).chain((lo > 0).then_some(0)) {
-                        if !tokens_ok[k] {
-                            row[k] = f32::NEG_INFINITY;
-                        }
-                    }
-                }
-            }
-            // Only the span (and key 0) can be visible: everything else stays 0, which saves
-            // the exponentials and value rows of the 90 keys outside a 31-frame window when
-            // sampling 120 frames.
-            let max = row[lo..hi].iter().fold(if lo > 0 { row[0] } else { f32::NEG_INFINITY }, |m, &v| m.max(v));
-            if max == f32::NEG_INFINITY {
-                row.fill(0.0);
-                continue;
-            }
-            row[lo..hi].iter_mut().for_each(|v| *v = exp(*v - max));
-            let mut sum = sum(&row[lo..hi]);
-            if lo > 0 {
-                row[0] = exp(row[0] - max);
-                sum += row[0];
-            }
-            let inv = 1.0 / sum;
-            row[lo..hi].iter_mut().for_each(|v| *v *= inv);
-            if lo > 0 {
-                row[0] *= inv;
             }
         }
     }
@@ -235,40 +239,38 @@ impl Attention {
     #[inline(always)]
     fn forward_body(&self, qkv: &[f32], c: Option<&[f32]>) -> Vec<f32> {
         let mut saved = self.saved.as_ref().map(|m| m.lock().unwrap_or_else(|e| e.into_inner()));
+        let (n, dh, w) = (self.groups.len, self.head_dim, self.width());
         if let Some(buf) = saved.as_mut() {
             buf.clear();
-            buf.resize(self.groups.groups * self.heads * self.groups.len * self.groups.len, 0.0);
+            buf.resize(self.groups.groups * self.heads * n * n, 0.0);
         }
-        let (n, dh, w) = (self.groups.len, self.head_dim, self.width());
         let mut y = vec![0f32; self.groups.rows() * w];
-        let mut s = Scratch::new(n, dh);
+        let mut p = vec![0f32; n * n];
         for g in 0..self.groups.groups {
-            s.fill_rows(&self.groups, g);
             for h in 0..self.heads {
-                self.gather(qkv, h, &mut s);
-                self.probabilities(c, g, h, &mut s);
-                if let Some(buf) = saved.as_mut() {
-                    buf[(g * self.heads + h) * n * n..(g * self.heads + h + 1) * n * n].copy_from_slice(&s.p);
-                }
-                for i in 0..n {
-                    let yi = s.rows[i] * w + h * dh;
-                    let out = &mut y[yi..yi + dh];
-                    let (lo, hi) = self.span(i);
-                    let prow = &s.p[i * n..(i + 1) * n];
-                    // y_i[e] = sum_k P_ik v_k[e]: a dot product over the visible keys per head
-                    // dimension, on the transposed values (long contiguous runs, not dh-long ones).
-                    for (e, o) in out.iter_mut().enumerate() {
-                        let vt = &s.vt[e * n..(e + 1) * n];
-                        *o = dot(&prow[lo..hi], &vt[lo..hi]) + if lo > 0 { prow[0] * vt[0] } else { 0.0 };
+                self.probabilities(qkv, c, g, h, &mut p);
+                let (_, _, v, out) = self.views(g, h);
+                // y = P V per block, plus the rest-pose key's share for blocks that miss it.
+                for (i0, i1, klo, khi) in self.blocks() {
+                    let pm = Strided { off: i0 * n + klo, rs: n, cs: 1 };
+                    small_gemm(&mut y, out.at(i0, 0), &p, pm, qkv, v.at(klo, 0), (i1 - i0, dh, khi - klo), 1.0, false);
+                    if klo > 0 {
+                        for i in i0..i1 {
+                            let (p0, o) = (p[i * n], out.at(i, 0).off);
+                            y[o..o + dh].iter_mut().zip(&qkv[v.off..v.off + dh]).for_each(|(y, v)| *y += p0 * v);
+                        }
                     }
+                }
+                if let Some(buf) = saved.as_mut() {
+                    buf[(g * self.heads + h) * n * n..(g * self.heads + h + 1) * n * n].copy_from_slice(&p);
                 }
             }
         }
         y
     }
 
-    /// Gradients of q/k/v (`[rows, 3w]`) and, for the topology bias, of `c`. The probabilities
-    /// are recomputed rather than kept from the forward pass: cheaper than storing them.
+    /// Gradients of q/k/v (`[rows, 3w]`) and, for the topology bias, of `c`, from the
+    /// probabilities the forward pass kept (recomputed when it kept none).
     fn backward(&self, qkv: &[f32], c: Option<&[f32]>, dy: &[f32]) -> Result<(Vec<f32>, Option<Vec<f32>>)> {
         self.check(qkv, c)?;
         if dy.len() != self.groups.rows() * self.width() {
@@ -291,81 +293,65 @@ impl Attention {
     #[inline(always)]
     fn backward_body(&self, qkv: &[f32], c: Option<&[f32]>, dy: &[f32]) -> (Vec<f32>, Option<Vec<f32>>) {
         let saved = self.saved.as_ref().map(|m| m.lock().unwrap_or_else(|e| e.into_inner()));
-        let (n, dh, w) = (self.groups.len, self.head_dim, self.width());
+        let (n, dh) = (self.groups.len, self.head_dim);
         let mut dqkv = vec![0f32; qkv.len()];
         let mut dc = c.map(|c| vec![0f32; c.len()]);
-        let mut s = Scratch::new(n, dh);
-        // Transposed gradients (`dh x len`) and dS (`len x len`) and its transpose, so that every
-        // inner loop is an axpy over keys or queries on contiguous memory.
-        let (mut dqt, mut dkt, mut dvt) = (vec![0f32; n * dh], vec![0f32; n * dh], vec![0f32; n * dh]);
-        let (mut ds, mut dst) = (vec![0f32; n * n], vec![0f32; n * n]);
-        let mut dyg = vec![0f32; n * dh];
+        let (mut p, mut ds) = (vec![0f32; n * n], vec![0f32; n * n]);
         for g in 0..self.groups.groups {
             let sample = g / self.groups.per_sample;
-            s.fill_rows(&self.groups, g);
             for h in 0..self.heads {
-                self.gather(qkv, h, &mut s);
                 match saved.as_ref().filter(|b| b.len() == self.groups.groups * self.heads * n * n) {
-                    Some(buf) => s.p.copy_from_slice(&buf[(g * self.heads + h) * n * n..(g * self.heads + h + 1) * n * n]),
-                    None => self.probabilities(c, g, h, &mut s),
+                    Some(buf) => p.copy_from_slice(&buf[(g * self.heads + h) * n * n..(g * self.heads + h + 1) * n * n]),
+                    None => self.probabilities(qkv, c, g, h, &mut p),
                 }
-                for i in 0..n {
-                    let r = s.rows[i] * w + h * dh;
-                    dyg[i * dh..(i + 1) * dh].copy_from_slice(&dy[r..r + dh]);
-                }
-                dqt.fill(0.0);
-                dkt.fill(0.0);
-                dvt.fill(0.0);
-                for i in 0..n {
-                    let prow = &s.p[i * n..(i + 1) * n];
-                    let dyi = &dyg[i * dh..(i + 1) * dh];
-                    let dsrow = &mut ds[i * n..(i + 1) * n];
-                    // dP_ik = dy_i · v_k, dS_ik = P_ik (dP_ik - sum_k P_ik dP_ik).
-                    dsrow.fill(0.0);
-                    for (e, &d) in dyi.iter().enumerate() {
-                        dsrow.iter_mut().zip(&s.vt[e * n..(e + 1) * n]).for_each(|(o, v)| *o += d * v);
-                        // dV^T[e] += dy_i[e] P_i
-                        dvt[e * n..(e + 1) * n].iter_mut().zip(prow).for_each(|(o, p)| *o += d * p);
-                    }
-                    let dot_pd: f32 = prow.iter().zip(dsrow.iter()).map(|(p, d)| p * d).sum();
-                    dsrow.iter_mut().zip(prow).for_each(|(d, p)| *d = p * (*d - dot_pd));
-                    // With pre-scaled queries qs the logits are qs·k: dK^T[e] += qs_i[e] dS_i.
-                    for e in 0..dh {
-                        let q = s.q[i * dh + e];
-                        dkt[e * n..(e + 1) * n].iter_mut().zip(dsrow.iter()).for_each(|(o, d)| *o += q * d);
-                    }
-                    if let (Some(dc), Keys::Topology { types, type_count, .. }) = (dc.as_mut(), &self.keys) {
-                        let at = (s.rows[i] * self.heads + h) * type_count;
-                        let pair_types = &types[(sample * n + i) * n..(sample * n + i + 1) * n];
-                        for (&d, &[a, b]) in dsrow.iter().zip(pair_types) {
-                            if a != NO_TYPE {
-                                dc[at + a as usize] += d;
-                            }
-                            if b != NO_TYPE {
-                                dc[at + b as usize] += d;
+                let (q, k, v, out) = self.views(g, h);
+                for (i0, i1, klo, khi) in self.blocks() {
+                    let (m, kn) = (i1 - i0, khi - klo);
+                    let pm = Strided { off: i0 * n + klo, rs: n, cs: 1 };
+                    // dP = dY V^T, then dS_ik = P_ik (dP_ik - sum_k P_ik dP_ik).
+                    small_gemm(&mut ds, pm, dy, out.at(i0, 0), qkv, v.at(klo, 0).t(), (m, kn, dh), 1.0, false);
+                    for i in i0..i1 {
+                        let dyi = &dy[out.at(i, 0).off..out.at(i, 0).off + dh];
+                        if klo > 0 {
+                            ds[i * n] = dyi.iter().zip(&qkv[v.off..v.off + dh]).map(|(a, b)| a * b).sum();
+                        }
+                        let (prow, dsrow) = (&p[i * n + klo..i * n + khi], &mut ds[i * n + klo..i * n + khi]);
+                        let mut dot_pd = dot(prow, dsrow);
+                        if klo > 0 {
+                            dot_pd += p[i * n] * ds[i * n];
+                            ds[i * n] = p[i * n] * (ds[i * n] - dot_pd);
+                        }
+                        let dsrow = &mut ds[i * n + klo..i * n + khi];
+                        dsrow.iter_mut().zip(prow).for_each(|(d, p)| *d = p * (*d - dot_pd));
+                        if let (Some(dc), Keys::Topology { types, type_count, .. }) = (dc.as_mut(), &self.keys) {
+                            let at = (self.groups.row(g, i) * self.heads + h) * type_count;
+                            let pair_types = &types[(sample * n + i) * n..(sample * n + i + 1) * n];
+                            for (&d, &[a, b]) in ds[i * n..(i + 1) * n].iter().zip(pair_types) {
+                                if a != NO_TYPE {
+                                    dc[at + a as usize] += d;
+                                }
+                                if b != NO_TYPE {
+                                    dc[at + b as usize] += d;
+                                }
                             }
                         }
                     }
-                }
-                // dQs^T[e][i] = sum_k K[k][e] dS[i][k]: through dS^T, again axpys over queries.
-                for i in 0..n {
-                    for k in 0..n {
-                        dst[k * n + i] = ds[i * n + k];
-                    }
-                }
-                for k in 0..n {
-                    let col = &dst[k * n..(k + 1) * n];
-                    for e in 0..dh {
-                        let kv = s.k[k * dh + e];
-                        dqt[e * n..(e + 1) * n].iter_mut().zip(col).for_each(|(o, d)| *o += kv * d);
-                    }
-                }
-                for i in 0..n {
-                    let r = s.rows[i] * 3 * w + h * dh;
-                    for e in 0..dh {
-                        dqkv[r + e] += dqt[e * n + i] * self.scale;
-                        dqkv[r + w + e] += dkt[e * n + i];
-                        dqkv[r + 2 * w + e] += dvt[e * n + i];
+                    // Logits are scale * q.k: dQ += scale dS K, dK += scale dS^T Q, dV += P^T dY.
+                    let (dsm, dst, pt) = (pm, pm.t(), pm.t());
+                    small_gemm(&mut dqkv, q.at(i0, 0), &ds, dsm, qkv, k.at(klo, 0), (m, dh, kn), self.scale, true);
+                    small_gemm(&mut dqkv, k.at(klo, 0), &ds, dst, qkv, q.at(i0, 0), (kn, dh, m), self.scale, true);
+                    small_gemm(&mut dqkv, v.at(klo, 0), &p, pt, dy, out.at(i0, 0), (kn, dh, m), 1.0, true);
+                    if klo > 0 {
+                        // The rest-pose key outside the block's range.
+                        for i in i0..i1 {
+                            let (d0, p0) = (ds[i * n] * self.scale, p[i * n]);
+                            let (qi, di) = (q.at(i, 0).off, out.at(i, 0).off);
+                            for e in 0..dh {
+                                dqkv[qi + e] += d0 * qkv[k.off + e];
+                                dqkv[k.off + e] += d0 * qkv[qi + e];
+                                dqkv[v.off + e] += p0 * dy[di + e];
+                            }
+                        }
                     }
                 }
             }
@@ -381,7 +367,7 @@ impl Attention {
 /// 2^n built in the exponent bits. Below -87 (including -inf, masked keys) the result is
 /// exactly 0, as a masked key must contribute nothing.
 #[inline(always)]
-fn exp(x: f32) -> f32 {
+pub(super) fn exp(x: f32) -> f32 {
     let xc = x.max(-87.0);
     let n = (xc * std::f32::consts::LOG2_E).round();
     let r = xc - n * 0.693_145_75 - n * 1.428_606_8e-6;
@@ -392,6 +378,21 @@ fn exp(x: f32) -> f32 {
     } else {
         p * scale
     }
+}
+
+/// Maximum with eight independent lanes (a running `f32::max` is a scalar chain; it was a
+/// sixth of the forward attention time). NaN never wins, as with `f32::max`.
+#[inline(always)]
+fn max(a: &[f32]) -> f32 {
+    let mut acc = [f32::NEG_INFINITY; 8];
+    let chunks = a.chunks_exact(8);
+    let tail = chunks.remainder().iter().fold(f32::NEG_INFINITY, |m, &v| m.max(v));
+    for x in chunks {
+        for l in 0..8 {
+            acc[l] = if x[l] > acc[l] { x[l] } else { acc[l] };
+        }
+    }
+    acc.iter().fold(tail, |m, &v| m.max(v))
 }
 
 /// Sum with eight independent partial sums (vectorisable, see `dot`).
@@ -423,27 +424,67 @@ fn dot(a: &[f32], b: &[f32]) -> f32 {
     acc.iter().sum::<f32>() + tail
 }
 
-/// Per-(group, head) buffers, reused across groups.
-struct Scratch {
-    q: Vec<f32>,
-    k: Vec<f32>,
-    kt: Vec<f32>,
-    v: Vec<f32>,
-    vt: Vec<f32>,
-    p: Vec<f32>,
-    /// Token row of each position of the current group.
-    rows: Vec<usize>,
+/// Queries per block of the windowed temporal attention (see `Attention::blocks`).
+const QUERY_BLOCK: usize = 32;
+
+/// A matrix inside a slice: element (r, c) at `off + r * rs + c * cs`. Heads of the q/k/v
+/// matrix are such views (row stride `3w` or `3wJ`), so no head is ever copied out.
+#[derive(Clone, Copy, Debug)]
+struct Strided {
+    off: usize,
+    rs: usize,
+    cs: usize,
 }
 
-impl Scratch {
-    fn new(n: usize, dh: usize) -> Scratch {
-        Scratch { q: vec![0.0; n * dh], k: vec![0.0; n * dh], kt: vec![0.0; n * dh], v: vec![0.0; n * dh], vt: vec![0.0; n * dh], p: vec![0.0; n * n], rows: vec![0; n] }
+impl Strided {
+    /// The view starting at element (r, c).
+    fn at(self, r: usize, c: usize) -> Strided {
+        Strided { off: self.off + r * self.rs + c * self.cs, ..self }
     }
 
-    fn fill_rows(&mut self, groups: &Groups, g: usize) {
-        for (i, r) in self.rows.iter_mut().enumerate() {
-            *r = groups.row(g, i);
-        }
+    fn t(self) -> Strided {
+        Strided { off: self.off, rs: self.cs, cs: self.rs }
+    }
+
+    fn fits(self, len: usize, rows: usize, cols: usize) -> bool {
+        rows == 0 || cols == 0 || self.off + (rows - 1) * self.rs + (cols - 1) * self.cs < len
+    }
+}
+
+/// `d = beta a b` (or `d += beta a b` when `accumulate`) for `a`: m x k, `b`: k x n views, with
+/// the gemm crate's register-blocked kernels on this thread. Why not loops: our per-query
+/// axpy loops ran at a fifth of gemm's speed on these 16-wide head dimensions (benches/nn.rs).
+#[allow(clippy::too_many_arguments)]
+fn small_gemm(d: &mut [f32], dm: Strided, a: &[f32], am: Strided, b: &[f32], bm: Strided, (m, n, k): (usize, usize, usize), beta: f32, accumulate: bool) {
+    assert!(dm.fits(d.len(), m, n) && am.fits(a.len(), m, k) && bm.fits(b.len(), k, n), "small_gemm: a view overruns its buffer");
+    if m == 0 || n == 0 || k == 0 {
+        assert!(accumulate || k > 0 || m == 0 || n == 0, "small_gemm: empty inner dimension");
+        return;
+    }
+    // SAFETY: every element the three views address is inside its slice (checked above), and
+    // `d` is borrowed mutably, so it overlaps neither `a` nor `b`.
+    unsafe {
+        gemm::gemm(
+            m,
+            n,
+            k,
+            d.as_mut_ptr().add(dm.off),
+            dm.cs as isize,
+            dm.rs as isize,
+            accumulate,
+            a.as_ptr().add(am.off),
+            am.cs as isize,
+            am.rs as isize,
+            b.as_ptr().add(bm.off),
+            bm.cs as isize,
+            bm.rs as isize,
+            1.0,
+            beta,
+            false,
+            false,
+            false,
+            gemm::Parallelism::None,
+        )
     }
 }
 

@@ -93,7 +93,7 @@ impl FeedForward {
     }
 
     pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
-        self.down.forward(&self.up.forward(x)?.gelu_erf()?)
+        self.down.forward(&super::gelu::gelu(&self.up.forward(x)?)?)
     }
 }
 

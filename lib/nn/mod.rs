@@ -2,7 +2,7 @@
 //!
 //! * [`config`]: `DenoiserConfig` with the `paper`, `small` and `tiny` presets;
 //! * [`layers`]: linear, layer norm, feed-forward and embeddings; [`fused`]: attention and layer
-//!   norm kernels with their own backward
+//!   norm kernels with their own backward, [`gelu`] likewise
 //!   (candle-nn's fused CPU kernels pass no gradients);
 //! * [`init`]: a `VarBuilder` that initialises new parameters from our seeded SplitMix64
 //!   (candle's CPU RNG cannot be seeded), so the same seed gives the same model bytes;
@@ -15,6 +15,7 @@ pub mod batch;
 pub mod config;
 pub mod init;
 pub mod fused;
+pub mod gelu;
 pub mod layers;
 
 #[cfg(test)]
