@@ -60,11 +60,19 @@ def metrics(bindir, folder, generated, skeleton):
             values = [f[k]["normalised"] for f in phys if "normalised" in f[k]]  # fish have no feet
             if values:
                 out[k] = sum(values) / len(values)
+                out[k + "_range"] = (min(values), max(values))
     return out
 
 
-def cells(m):
-    return [f"{m[k]:.3f}" for k, _ in METRICS] + [f"{m[k]:.3f}" if k in m else "-" for k, _ in PHYSICS]
+def cells(m, ranges=False):
+    def phys(k):
+        if k not in m:
+            return "-"
+        if ranges and k + "_range" in m:
+            lo, hi = m[k + "_range"]
+            return f"{m[k]:.3f} ({lo:.3f}-{hi:.3f})"
+        return f"{m[k]:.3f}"
+    return [f"{m[k]:.3f}" for k, _ in METRICS] + [phys(k) for k, _ in PHYSICS]
 
 
 def sample(bindir, model, skeleton, out, n, frames, steps, sampler, seed):
@@ -106,7 +114,9 @@ def main():
         name = os.path.basename(folder.rstrip("/"))
         skeleton = clips(folder)[0]
         m = metrics(args.bin, folder, folder, skeleton)  # the clips against themselves
-        print(row([name, "gt (the clips)"] + cells(m)), flush=True)
+        # The clips' physics with their per-clip range in brackets: "within the range of the
+        # training data" is judged against it.
+        print(row([name, "gt (the clips)"] + cells(m, ranges=True)), flush=True)
         for label, model in models:
             out = os.path.join(tmp, f"{name}_{label}")
             sample(args.bin, model, skeleton, out, args.n, args.frames, args.steps, args.sampler, args.seed)

@@ -3,11 +3,12 @@
 //! Why: built from candle's basic ops, one attention layer is some twenty passes over the
 //! J x J and T x T logit tensors (bias add, max, subtract, exp, sum, divide, their backward
 //! passes, permutes to and from the head layout), each into a freshly allocated tensor. On our
-//! CPUs that made the model run at 3-10% of matmul peak (benches/nn.rs). Here one loop per
-//! (group, head) computes the probabilities in a small scratch buffer, recomputes them in the
-//! backward pass instead of storing them, and reads queries, keys and values straight from the
-//! `[rows, 3 * width]` output of the fused q/k/v projection, so no head split, merge or
-//! transpose is ever materialised.
+//! CPUs that made the model run at 3-10% of matmul peak (benches/nn.rs). Here each (group,
+//! head) is four small GEMMs (logits, output; three more in the backward) that read queries,
+//! keys and values in place from the `[rows, 3 * width]` output of the fused q/k/v projection
+//! through strides, so no head split, merge or transpose is ever materialised, and one pass
+//! per row adds the bias and masks and takes the softmax. The probabilities are kept for the
+//! backward pass when there is one.
 //!
 //! (candle-nn's fused softmax / layer norm / sdpa have no CPU backward, see `layers`; these do,
 //! and `tests` checks them against the composition of basic ops, values and gradients.)
