@@ -6,6 +6,10 @@ use crate::nn::layers::softmax;
 use crate::synth::SplitMix64;
 use candle_core::{Device, Var, D};
 
+fn values(t: &Tensor) -> Result<Vec<f32>> {
+    t.flatten_all()?.to_vec1::<f32>()
+}
+
 fn random(rng: &mut SplitMix64, n: usize) -> Vec<f32> {
     (0..n).map(|_| rng.range(-1.5, 1.5) as f32).collect()
 }
