@@ -26,6 +26,7 @@ use super::graph::{SkeletonGraph, EDGE_DIMS};
 use super::{SataConfig, FEATURE_DIMS, INPUT_DIMS};
 use crate::nn::anytop::{project_qkv, PerJointType};
 use crate::nn::fused::{self, Groups, Keys};
+use crate::nn::gelu::gelu;
 use crate::nn::layers::{sinusoid, FeedForward, LayerNorm, Linear};
 use crate::nn::NnError;
 use candle_core::{DType, Tensor, D};
@@ -78,7 +79,7 @@ impl Modulation {
     fn condition(&self, g: &SkeletonGraph) -> candle_core::Result<Tensor> {
         let zs = self.spatial.forward(&spatial_encoding(&g.statics, self.frequencies)?)?;
         let zt = self.text.forward(&g.names)?;
-        self.cond_b.forward(&self.cond_a.forward(&Tensor::cat(&[zs, zt], 1)?)?.gelu_erf()?)
+        self.cond_b.forward(&gelu(&self.cond_a.forward(&Tensor::cat(&[zs, zt], 1)?)?)?)
     }
 
     /// `z`: `[B, T, J, d]`, `c`: `[J, d]`.
@@ -182,7 +183,7 @@ impl Block {
         let edge = self.edge_b.forward(&self.edge_a.forward(&g.edges)?.relu()?)?; // [E, d]
         let messages = g.gather.broadcast_matmul(&rows)?.broadcast_add(&edge)?.relu()?; // [BT, E, d]
         let summed = g.scatter.broadcast_matmul(&messages)?; // [BT, J, d]
-        self.gine_b.forward(&self.gine_a.forward(&(rows + summed)?)?.gelu_erf()?)?.reshape((s.b, s.t, s.j, d))
+        self.gine_b.forward(&gelu(&self.gine_a.forward(&(rows + summed)?)?)?)?.reshape((s.b, s.t, s.j, d))
     }
 
     fn forward(&self, h: &Tensor, g: &SkeletonGraph, s: &Shape, positions: &Tensor) -> candle_core::Result<Tensor> {
