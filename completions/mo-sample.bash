@@ -23,12 +23,16 @@ _mo__sample() {
 
     case "${cmd}" in
         mo__sample)
-            opts="-n -o -q -v -h -V --model --samples --frames --seconds --steps --sampler --bvh --reference --keep-frames --keep-joints --report --smooth --blend --no-plant-feet --output --seed --quiet --verbose --threads --help --version"
+            opts="-n -o -q -v -h -V --skeleton --model --samples --frames --seconds --steps --sampler --bvh --reference --keep-frames --keep-joints --report --smooth --blend --no-plant-feet --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
             fi
             case "${prev}" in
+                --skeleton)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 --model)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0

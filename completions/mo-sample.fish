@@ -1,3 +1,4 @@
+complete -c mo-sample -l skeleton -d 'The same as SKELETON, as a named option' -r -F
 complete -c mo-sample -l model -d 'Model directory written by mo-train [default: the built-in model, a small denoiser trained on the synthetic zoo; see models/zoo-small/MODEL_CARD.md]' -r -F
 complete -c mo-sample -s n -l samples -d 'Number of samples' -r
 complete -c mo-sample -l frames -d 'Frames per sample [default: 120; with --reference: the reference\'s length]' -r

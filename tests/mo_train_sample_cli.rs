@@ -44,6 +44,9 @@ fn resume_equals_the_straight_run_and_samples_are_deterministic() {
         ok(&a, skel);
         let b = run("mo-sample", &args, None);
         assert_eq!(a.stdout, b.stdout, "{skel}: same seed, same bytes");
+        let mut named = args.to_vec();
+        named.insert(0, "--skeleton");
+        assert_eq!(run("mo-sample", &named, None).stdout, a.stdout, "{skel}: --skeleton PATH = the positional SKELETON");
         let array = menagerie::io::npy::from_bytes(&a.stdout, skel).unwrap();
         let (skeleton, _) = common::load(&example(skel));
         assert_eq!(array.shape, vec![2, 16, skeleton.len(), 13]);

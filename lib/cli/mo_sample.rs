@@ -81,6 +81,9 @@ pub struct Args {
     /// Skeleton document or BVH ('-' = stdin) [default: stdin; with --reference: the reference].
     #[arg(value_name = "SKELETON")]
     pub skeleton: Option<PathBuf>,
+    /// The same as SKELETON, as a named option.
+    #[arg(long = "skeleton", value_name = "PATH", conflicts_with = "skeleton")]
+    pub skeleton_option: Option<PathBuf>,
     /// Model directory written by mo-train [default: the built-in model, a small denoiser
     /// trained on the synthetic zoo; see models/zoo-small/MODEL_CARD.md].
     #[arg(long, value_name = "DIR")]
@@ -155,7 +158,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => None,
     };
     let dash = PathBuf::from("-");
-    let arg = read_skeleton(args.skeleton.as_ref().or(args.reference.as_ref()).unwrap_or(&dash))?;
+    let arg = read_skeleton(args.skeleton.as_ref().or(args.skeleton_option.as_ref()).or(args.reference.as_ref()).unwrap_or(&dash))?;
     let skeleton = &arg.skeleton;
     let device = Device::Cpu;
     let loaded = match &args.model {
