@@ -162,12 +162,12 @@ impl Attention {
     /// logits of each block as one small GEMM, then bias, masks and softmax per row. Columns a
     /// query cannot see are 0; columns outside its block's key range are not touched.
     #[inline(always)]
-    fn probabilities(&self, qkv: &[f32], c: Option<&[f32]>, g: usize, h: usize, p: &mut [f32]) {
+    fn probabilities(&self, qkv: &[f32], c: Option<&[f32]>, g: usize, h: usize, blocks: &[(usize, usize, usize, usize)], p: &mut [f32]) {
         let (n, dh) = (self.groups.len, self.head_dim);
         let sample = g / self.groups.per_sample;
         let (q, k, _, _) = self.views(g, h);
         let mut coefficients: Vec<f32> = Vec::new();
-        for (i0, i1, klo, khi) in self.blocks() {
+        for &(i0, i1, klo, khi) in blocks {
             let pm = Strided { off: i0 * n + klo, rs: n, cs: 1 };
             small_gemm(p, pm, qkv, q.at(i0, 0), qkv, k.at(klo, 0).t(), (i1 - i0, khi - klo, dh), self.scale, false);
             for i in i0..i1 {
@@ -254,12 +254,13 @@ impl Attention {
         }
         let mut y = vec![0f32; self.groups.rows() * w];
         let mut p = vec![0f32; n * n];
+        let blocks = self.blocks();
         for g in 0..self.groups.groups {
             for h in 0..self.heads {
-                self.probabilities(qkv, c, g, h, &mut p);
+                self.probabilities(qkv, c, g, h, &blocks, &mut p);
                 let (_, _, v, out) = self.views(g, h);
                 // y = P V per block, plus the rest-pose key's share for blocks that miss it.
-                for (i0, i1, klo, khi) in self.blocks() {
+                for &(i0, i1, klo, khi) in &blocks {
                     let pm = Strided { off: i0 * n + klo, rs: n, cs: 1 };
                     small_gemm(&mut y, out.at(i0, 0), &p, pm, qkv, v.at(klo, 0), (i1 - i0, dh, khi - klo), 1.0, false);
                     if klo > 0 {
@@ -305,15 +306,16 @@ impl Attention {
         let mut dqkv = vec![0f32; qkv.len()];
         let mut dc = c.map(|c| vec![0f32; c.len()]);
         let (mut p, mut ds) = (vec![0f32; n * n], vec![0f32; n * n]);
+        let blocks = self.blocks();
         for g in 0..self.groups.groups {
             let sample = g / self.groups.per_sample;
             for h in 0..self.heads {
                 match saved.as_ref().filter(|b| b.len() == self.groups.groups * self.heads * n * n) {
                     Some(buf) => p.copy_from_slice(&buf[(g * self.heads + h) * n * n..(g * self.heads + h + 1) * n * n]),
-                    None => self.probabilities(qkv, c, g, h, &mut p),
+                    None => self.probabilities(qkv, c, g, h, &blocks, &mut p),
                 }
                 let (q, k, v, out) = self.views(g, h);
-                for (i0, i1, klo, khi) in self.blocks() {
+                for &(i0, i1, klo, khi) in &blocks {
                     let (m, kn) = (i1 - i0, khi - klo);
                     let pm = Strided { off: i0 * n + klo, rs: n, cs: 1 };
                     // dP = dY V^T, then dS_ik = P_ik (dP_ik - sum_k P_ik dP_ik).
@@ -345,10 +347,9 @@ impl Attention {
                         }
                     }
                     // Logits are scale * q.k: dQ += scale dS K, dK += scale dS^T Q, dV += P^T dY.
-                    let (dsm, dst, pt) = (pm, pm.t(), pm.t());
-                    small_gemm(&mut dqkv, q.at(i0, 0), &ds, dsm, qkv, k.at(klo, 0), (m, dh, kn), self.scale, true);
-                    small_gemm(&mut dqkv, k.at(klo, 0), &ds, dst, qkv, q.at(i0, 0), (kn, dh, m), self.scale, true);
-                    small_gemm(&mut dqkv, v.at(klo, 0), &p, pt, dy, out.at(i0, 0), (kn, dh, m), 1.0, true);
+                    small_gemm(&mut dqkv, q.at(i0, 0), &ds, pm, qkv, k.at(klo, 0), (m, dh, kn), self.scale, true);
+                    small_gemm(&mut dqkv, k.at(klo, 0), &ds, pm.t(), qkv, q.at(i0, 0), (kn, dh, m), self.scale, true);
+                    small_gemm(&mut dqkv, v.at(klo, 0), &p, pm.t(), dy, out.at(i0, 0), (kn, dh, m), 1.0, true);
                     if klo > 0 {
                         // The rest-pose key outside the block's range.
                         for i in i0..i1 {
