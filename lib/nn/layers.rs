@@ -28,6 +28,14 @@ impl Linear {
         Ok(Linear { weight, bias, inputs, outputs })
     }
 
+    /// Weight and bias initialised to zero: a new path added to a trained model starts
+    /// silent, so the model begins where it was.
+    pub fn zeros(vb: VarBuilder, inputs: usize, outputs: usize) -> Result<Linear> {
+        let weight = vb.get_with_hints((outputs, inputs), "weight", Init::Const(0.0))?;
+        let bias = vb.get_with_hints(outputs, "bias", Init::Const(0.0))?;
+        Ok(Linear { weight, bias, inputs, outputs })
+    }
+
     pub fn weight(&self) -> &Tensor {
         &self.weight
     }

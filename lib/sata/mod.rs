@@ -58,6 +58,16 @@ pub struct SataConfig {
     /// Frames shared by consecutive inference windows (the paper's 16).
     pub overlap: usize,
     pub ln_eps: f64,
+    /// The latent is the encoder's output minus its output for the same skeleton standing
+    /// still in its rest pose ([`model::SataModel::encode`]): what the body does, not which
+    /// body it is. False in checkpoints written before it (their latents are absolute).
+    #[serde(default)]
+    pub relative_latent: bool,
+    /// A direct linear read-out of the latent at every joint, its matrix made from the joint's
+    /// condition (rest offsets and name; [`model::SataModel::decode`]). False in checkpoints
+    /// written before it.
+    #[serde(default)]
+    pub direct_readout: bool,
 }
 
 /// AnyTop's 13 features per joint and frame.
@@ -69,7 +79,7 @@ impl SataConfig {
     /// The paper's base model (§4.1.1): width 256, 3 + 3 blocks, 4 heads, ff 512, latent 128,
     /// windows of 64 frames overlapping by 16.
     pub fn paper() -> SataConfig {
-        SataConfig { width: 256, blocks: 3, heads: 4, ff: 512, latent: 128, frequencies: 6, name_dim: 384, window: 64, overlap: 16, ln_eps: 1e-5 }
+        SataConfig { width: 256, blocks: 3, heads: 4, ff: 512, latent: 128, frequencies: 6, name_dim: 384, window: 64, overlap: 16, ln_eps: 1e-5, relative_latent: true, direct_readout: true }
     }
 
     /// What trains on our CPUs in an hour or two: width 64, 2 + 2 blocks, 32-frame windows

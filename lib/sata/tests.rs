@@ -147,3 +147,34 @@ fn the_latent_cycle_reaches_decoder_and_encoder_and_can_be_learned() {
     let last = cycle(&model).to_scalar::<f32>().unwrap();
     assert!(last < first * 0.5, "cycle loss {first} -> {last}");
 }
+
+#[test]
+fn a_relative_latent_is_zero_at_rest_and_old_configs_stay_absolute() {
+    let (_, g, f) = clip("quadruped");
+    let scale = FeatureScale::measure([(&f, g.rest.as_slice())]);
+    let mut rest = Features::zeros(10, g.joints, 13);
+    for frame in rest.data.chunks_exact_mut(g.joints * 13) {
+        frame.copy_from_slice(&g.rest);
+    }
+    let still = tensor(&rest, 10, &scale, &g);
+    let moving = tensor(&f, 10, &scale, &g);
+    for relative in [true, false] {
+        let varmap = VarMap::new();
+        let cfg = SataConfig { relative_latent: relative, ..SataConfig::tiny() };
+        let model = SataModel::new(seeded_var_builder(&varmap, 13, &Device::Cpu), &cfg).unwrap();
+        let size = |t: &Tensor| t.abs().unwrap().max_all().unwrap().to_scalar::<f32>().unwrap();
+        let (at_rest, _) = model.encode(&still, &g).unwrap();
+        let (walking, _) = model.encode(&moving, &g).unwrap();
+        assert!(size(&walking) > 1e-3, "relative {relative}: a moving clip's latent is {}", size(&walking));
+        if relative {
+            assert!(size(&at_rest) < 1e-6, "the rest pose standing still encodes to {}", size(&at_rest));
+        } else {
+            assert!(size(&at_rest) > 1e-3, "an absolute latent of the rest pose is {}", size(&at_rest));
+        }
+    }
+    // Checkpoints written before the option decode as they were trained: absolute latents.
+    let mut json = serde_json::to_value(SataConfig::small()).unwrap();
+    json.as_object_mut().unwrap().remove("relative_latent");
+    let old: SataConfig = serde_json::from_value(json).unwrap();
+    assert!(!old.relative_latent);
+}
