@@ -24,7 +24,7 @@ use menagerie::metrics::physics::PhysicsOptions;
 use menagerie::metrics::reconstruction::{reconstruction, rotation_joints, ReconstructionReport, Rotations};
 use menagerie::metrics::Clip as MetricClip;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::Placement;
+use menagerie::repr::anytop::{AnyTopOptions, Placement, RestSource};
 use menagerie::repr::Features;
 use menagerie::sata::checkpoint::{self, Frozen};
 use menagerie::sata::infer::{Latents, Prepared};
@@ -49,6 +49,9 @@ struct Clip {
     name: String,
     skeleton: Skeleton,
     motion: Motion,
+    /// For a skel-aug variant: its original's rest pose, augmented the same way, so its rig
+    /// is measured from the same pose as the original's (else: the clip's first frame).
+    rest: Option<Motion>,
 }
 
 fn read(path: &Path) -> Option<Clip> {
@@ -57,7 +60,7 @@ fn read(path: &Path) -> Option<Clip> {
     skeleton.validate().ok()?;
     let motion = Motion::from_bvh(&parsed, &skeleton).first_frames(MAX_FRAMES);
     let name = path.strip_prefix(path.ancestors().nth(2)?).ok()?.to_string_lossy().into_owned();
-    (motion.frames >= 20).then_some(Clip { name, skeleton, motion })
+    (motion.frames >= 20).then_some(Clip { name, skeleton, motion, rest: None })
 }
 
 /// (set name, clips).
@@ -96,19 +99,32 @@ fn models(device: &Device) -> Vec<(String, Frozen)> {
         .collect()
 }
 
-/// A clip encoded with its own rig: features, placement, prepared graph.
+/// A clip's features, placement and prepared graph.
 struct Encoded {
     prepared: Prepared,
+    /// The clip's skeleton as the rig reads it (`KnownRig::fit`).
+    skeleton: Skeleton,
     features: Features,
     placement: Placement,
 }
 
-fn encode(clip: &Clip, device: &Device) -> Option<Encoded> {
+/// A clip encoded for `model`: with the rig it was trained with when it knows the skeleton
+/// (as `mo-encode --latent` does), else the clip's own.
+fn encode(clip: &Clip, model: Option<&Frozen>, device: &Device) -> Option<Encoded> {
     let go = || -> anyhow::Result<Encoded> {
-        let section = AnyTopSection::of_clip(&clip.skeleton, &clip.motion, &clip.name)?;
-        let e = section.rig.encode(&clip.skeleton, &clip.motion)?;
-        let prepared = Prepared::new(&clip.skeleton, section, NameTable::builtin()?, device)?;
-        Ok(Encoded { prepared, features: e.features, placement: e.placement })
+        let (section, skeleton) = match model.and_then(|m| m.rigs.find(&clip.skeleton)) {
+            Some(known) => (known.section.clone(), known.fit(&clip.skeleton)),
+            None => match &clip.rest {
+                Some(rest) => {
+                    let options = AnyTopOptions { rest_source: RestSource::Explicit { file: format!("{} (augmented rest)", clip.name) }, ..AnyTopOptions::default() };
+                    (AnyTopSection::new(&clip.skeleton, rest, &options)?, clip.skeleton.clone())
+                }
+                None => (AnyTopSection::of_clip(&clip.skeleton, &clip.motion, &clip.name)?, clip.skeleton.clone()),
+            },
+        };
+        let e = section.rig.encode(&skeleton, &clip.motion)?;
+        let prepared = Prepared::new(&skeleton, section, NameTable::builtin()?, device)?;
+        Ok(Encoded { prepared, skeleton, features: e.features, placement: e.placement })
     };
     go().map_err(|e| println!("(skipped {}: {e:#})", clip.name)).ok()
 }
@@ -128,7 +144,7 @@ fn mean_pose(f: &Features) -> Features {
 /// Score `features` (decoded on `target` at its true placement) against `truth`.
 fn score(target: &Clip, enc: &Encoded, features: &Features) -> Option<ReconstructionReport> {
     let go = || -> anyhow::Result<ReconstructionReport> {
-        let result = enc.prepared.section.rig.decode(&target.skeleton, features, &enc.placement)?;
+        let result = enc.prepared.section.rig.decode(&enc.skeleton, features, &enc.placement)?;
         let truth = target.motion.first_frames(result.frames);
         let counted = rotation_joints(&target.skeleton);
         let rotations = Rotations { reference: &truth.rotations, result: &result.rotations, counted };
@@ -175,6 +191,18 @@ fn distance(a: &Latents, b: &Latents) -> f64 {
     (0..n).map(|f| a.data[f * d..(f + 1) * d].iter().zip(&b.data[f * d..(f + 1) * d]).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt()).sum::<f64>() / n.max(1) as f64
 }
 
+/// The first two frames of the clip `model` took `clip`'s rest pose from, when it knows the
+/// skeleton and the file is readable (the frames `AnyTopSection` measures a rig on).
+/// The clip comes back on the trained offsets (`KnownRig::fit`), the skeleton the rest fits.
+fn trained_rest(model: &Frozen, clip: &Clip) -> Option<Clip> {
+    let known = model.rigs.find(&clip.skeleton)?;
+    let (RestSource::TPose { file } | RestSource::FirstClip { file } | RestSource::Explicit { file }) = &known.section.rig.rest_source else { return None };
+    let parsed = bvh::read_path(Path::new(file)).ok()?;
+    let rest = Motion::from_bvh(&parsed, &Skeleton::from_bvh(&parsed)).first_frames(2);
+    (rest.joints == clip.skeleton.len()).then(|| Clip { name: clip.name.clone(), skeleton: known.fit(&clip.skeleton), motion: clip.motion.clone(), rest: Some(rest) })
+}
+
+/// The clip's rest frames, when it has them, are augmented along with it (see `Clip::rest`).
 fn variants(clip: &Clip, count: usize, seed: u64) -> Vec<Clip> {
     let mut rng = SplitMix64::new(seed);
     (0..count)
@@ -182,7 +210,8 @@ fn variants(clip: &Clip, count: usize, seed: u64) -> Vec<Clip> {
             let opts = augment::Options { remove: Some(RemoveAmount::Random), add: 2, keep_feet: true };
             let plan = augment::plan(&clip.skeleton, &opts, &mut rng);
             let motion = plan.apply_motion(&clip.skeleton, &clip.motion);
-            Clip { name: format!("{}~v{k}", clip.name), skeleton: plan.skeleton, motion }
+            let rest = clip.rest.as_ref().map(|r| plan.apply_motion(&clip.skeleton, r));
+            Clip { name: format!("{}~v{k}", clip.name), skeleton: plan.skeleton, motion, rest }
         })
         .collect()
 }
@@ -203,7 +232,7 @@ fn main() {
             let (mut same, mut other, mut nearest, mut total) = (0.0, 0.0, 0usize, 0usize);
             let mut encoded_latents: Vec<(Latents, Vec<Latents>)> = Vec::new();
             for clip in clips {
-                let Some(enc) = encode(clip, &device) else { continue };
+                let Some(enc) = encode(clip, Some(model), &device) else { continue };
                 let Ok(z) = model.encode_features(&enc.features, &enc.prepared.graph, &device) else { continue };
                 let Ok(back) = model.decode_latents(&z, &enc.prepared.graph, &device) else { continue };
                 if let Some(r) = score(clip, &enc, &back) {
@@ -218,8 +247,9 @@ fn main() {
                 }
                 // Onto skel-aug variants, whose own motion is the ground truth.
                 let mut variant_latents = Vec::new();
-                for v in variants(clip, 2, 11) {
-                    let Some(venc) = encode(&v, &device) else { continue };
+                let base = trained_rest(model, clip);
+                for v in variants(base.as_ref().unwrap_or(clip), 2, 11) {
+                    let Some(venc) = encode(&v, Some(model), &device) else { continue };
                     if let Ok(on_v) = model.decode_latents(&z, &venc.prepared.graph, &device) {
                         if let Some(r) = score(&v, &venc, &on_v) {
                             retarget.add(&r);
@@ -277,8 +307,8 @@ fn ground_truth_pairs(models: &[(String, Frozen)], device: &Device) {
     let pairs = [("cmu_bvh11/131_01.bvh", "cmu_bvh11/scaled_131_01.bvh")];
     for (a, b) in pairs {
         let (Some(src), Some(dst)) = (read(&corpus.join(a)), read(&corpus.join(b))) else { continue };
-        let (Some(se), Some(de)) = (encode(&src, device), encode(&dst, device)) else { continue };
         for (name, model) in models {
+            let (Some(se), Some(de)) = (encode(&src, Some(model), device), encode(&dst, Some(model), device)) else { continue };
             let Ok(z) = model.encode_features(&se.features, &se.prepared.graph, device) else { continue };
             let Ok(on) = model.decode_latents(&z, &de.prepared.graph, device) else { continue };
             let mut m = Mean::default();
@@ -311,8 +341,8 @@ fn speed(models: &[(String, Frozen)], device: &Device) {
         long.frames += motion.frames;
     }
     let long = long.first_frames(1001);
-    let clip = Clip { name: "quadruped x1000".into(), skeleton, motion: long };
-    let enc = encode(&clip, device).expect("encodable");
+    let clip = Clip { name: "quadruped x1000".into(), skeleton, motion: long, rest: None };
+    let enc = encode(&clip, None, device).expect("encodable");
     println!("\n## Speed: 1000 frames, {n} joints (encode + decode, median of {} runs)\n", common::RUNS);
     println!("| model | encode ms | decode ms | total ms | frames/s |\n|---|---|---|---|---|");
     for (name, model) in models {

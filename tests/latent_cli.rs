@@ -97,4 +97,32 @@ fn a_trained_latent_model_resumes_and_serves_the_tools() {
     let out = run("mo-encode", &["--latent", "--model", s(&model), s(&example("spider.bvh"))], None);
     ok(&out, "encode with the trained model");
     assert_eq!(npy::from_bytes(&out.stdout, "z").unwrap().shape[1], 16, "the tiny preset's latent");
+
+    // The model keeps the rig of every skeleton it trained on, and reads and writes a trained
+    // skeleton with it whatever clip of it is given: onto the spider from its clip and from the
+    // same clip without its first frames (another first frame, so another rest pose of its
+    // own), the transfer is the same. Without rigs.json each clip brings its own rig.
+    let rigs: serde_json::Value = serde_json::from_slice(&std::fs::read(model.join("rigs.json")).unwrap()).unwrap();
+    assert_eq!(rigs["rigs"].as_array().map(Vec::len), Some(9), "one rig per example skeleton");
+    let shifted = dir.join("spider_later.bvh");
+    std::fs::write(&shifted, drop_frames(&std::fs::read_to_string(example("spider.bvh")).unwrap(), 7)).unwrap();
+    let onto = |target: &Path| {
+        let out = run("mo-retarget", &["--method", "latent", "--model", s(&model), s(&example("quadruped.bvh")), "--to", s(target)], None);
+        ok(&out, "latent transfer onto the spider");
+        out.stdout
+    };
+    assert_eq!(onto(&example("spider.bvh")), onto(&shifted), "one rig for the trained spider");
+    std::fs::remove_file(model.join("rigs.json")).unwrap();
+    assert_ne!(onto(&example("spider.bvh")), onto(&shifted), "each clip's own first frame");
+}
+
+/// A BVH text without its first `n` frames.
+fn drop_frames(text: &str, n: usize) -> String {
+    let (head, motion) = text.split_once("MOTION").unwrap();
+    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
+    let frames: usize = lines.next().unwrap().trim_start_matches("Frames:").trim().parse().unwrap();
+    let time = lines.next().unwrap();
+    let rest: Vec<&str> = lines.skip(n).collect();
+    assert_eq!(rest.len(), frames - n);
+    format!("{head}MOTION\nFrames: {}\n{time}\n{}\n", frames - n, rest.join("\n"))
 }

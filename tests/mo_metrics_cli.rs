@@ -102,6 +102,31 @@ fn physics_runs_on_the_whole_corpus() {
     assert!(total > 40, "scored {total} corpus files");
 }
 
+/// `path`'s BVH text without its last `n` frames.
+fn without_last_frames(path: &Path, n: usize) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let (head, motion) = text.split_once("MOTION").unwrap();
+    let lines: Vec<&str> = motion.lines().filter(|l| !l.trim().is_empty()).collect();
+    let frames: usize = lines[0].trim_start_matches("Frames:").trim().parse().unwrap();
+    format!("{head}MOTION\nFrames: {}\n{}\n{}\n", frames - n, lines[1], lines[2..2 + frames - n].join("\n"))
+}
+
+#[test]
+fn a_decoded_round_trip_one_frame_short_is_compared_on_its_frames() {
+    // Features and latents of an F-frame clip describe F - 1 frames (the last one only gives
+    // velocities), so encode -> decode hands back one frame fewer.
+    let dir = tempdir("short");
+    let dragon = example("dragon.bvh");
+    let short = dir.join("short.bvh");
+    std::fs::write(&short, without_last_frames(&dragon, 1)).unwrap();
+    let v = json(&run("mo-metrics", &["reconstruction", "--reference", s(&dragon), "--result", s(&short), "-q"], None), "one frame short");
+    assert_eq!(num(&v, "report.jr"), 0.0, "the frames it has are the reference's");
+    assert_eq!(num(&v, "report.jp.value"), 0.0);
+    std::fs::write(&short, without_last_frames(&dragon, 2)).unwrap();
+    let out = run("mo-metrics", &["reconstruction", "--reference", s(&dragon), "--result", s(&short)], None);
+    check_failure("mo-metrics", "two frames short", &out, "frame by frame");
+}
+
 #[test]
 fn bad_input_exits_2() {
     let dir = tempdir("bad");

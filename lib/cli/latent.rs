@@ -22,13 +22,25 @@ pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<Frozen>
         None => {
             const INFO: &[u8] = include_bytes!("../../models/zoo-sata/checkpoint.json");
             const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-sata/model.safetensors");
-            checkpoint::frozen_bytes(INFO, WEIGHTS, device).context("the built-in latent model")
+            const RIGS: &[u8] = include_bytes!("../../models/zoo-sata/rigs.json");
+            checkpoint::frozen_bytes(INFO, WEIGHTS, Some(RIGS), device).context("the built-in latent model")
         }
     }
 }
 
-/// A BVH clip read for encoding: skeleton, motion and its own AnyTop record (rig on its first
-/// frames, as `mo-encode` builds for a lone clip).
+/// The rig to read or write `skeleton`'s motion with, and the skeleton it fits: the model's
+/// training rig when it knows the skeleton (`sata::rigs`: the rest pose its rotations are
+/// measured from, on the offsets it trained with), else `own` (the clip's or document's).
+fn rig_for(model: &Frozen, skeleton: &Skeleton, own: impl FnOnce() -> anyhow::Result<AnyTopSection>) -> anyhow::Result<(AnyTopSection, Skeleton)> {
+    match model.rigs.find(skeleton) {
+        Some(known) => Ok((known.section.clone(), known.fit(skeleton))),
+        None => Ok((own()?, skeleton.clone())),
+    }
+}
+
+/// A BVH clip read for encoding: skeleton, motion and its AnyTop record (the model's rig for
+/// a trained skeleton, else one on the clip's first frames, as `mo-encode` builds for a lone
+/// clip).
 pub struct SourceClip {
     pub name: String,
     pub skeleton: Skeleton,
@@ -36,7 +48,7 @@ pub struct SourceClip {
     pub prepared: Prepared,
 }
 
-pub fn read_source(path: &Path, device: &Device) -> anyhow::Result<SourceClip> {
+pub fn read_source(path: &Path, model: &Frozen, device: &Device) -> anyhow::Result<SourceClip> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
     if bytes.starts_with(b"\x93NUMPY") {
@@ -49,7 +61,7 @@ pub fn read_source(path: &Path, device: &Device) -> anyhow::Result<SourceClip> {
     if motion.frames < 2 {
         bail!("{name}: {} frame(s); a clip needs at least 2 frames to encode (velocities need a next frame)", motion.frames);
     }
-    let section = AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig"))?;
+    let (section, skeleton) = rig_for(model, &skeleton, || AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig")))?;
     let prepared = Prepared::new(&skeleton, section, names()?, device).with_context(|| name.clone())?;
     Ok(SourceClip { name, skeleton, motion, prepared })
 }
@@ -67,17 +79,20 @@ pub fn encode(model: &Frozen, clip: &SourceClip, device: &Device) -> anyhow::Res
     model.encode_features(&encoded.features, &clip.prepared.graph, device).with_context(|| clip.name.clone())
 }
 
-/// The skeleton to decode onto (`--skeleton`/`--to`: a document or a BVH) with its rig and graph.
+/// The skeleton to decode onto (`--skeleton`/`--to`: a document or a BVH) with its rig (the
+/// model's for a trained skeleton, else the document's or the BVH's first frame) and graph.
 pub struct Target {
     pub arg: SkeletonArg,
+    /// `arg`'s skeleton as the rig reads it (`rig_for`); the output keeps `arg`'s offsets.
+    pub fitted: Skeleton,
     pub prepared: Prepared,
 }
 
-pub fn read_target(path: &Path, device: &Device) -> anyhow::Result<Target> {
+pub fn read_target(path: &Path, model: &Frozen, device: &Device) -> anyhow::Result<Target> {
     let arg = read_skeleton(path)?;
-    let section = arg.record()?;
-    let prepared = Prepared::new(&arg.skeleton, section, names()?, device).with_context(|| arg.name.clone())?;
-    Ok(Target { arg, prepared })
+    let (section, fitted) = rig_for(model, &arg.skeleton, || arg.record())?;
+    let prepared = Prepared::new(&fitted, section, names()?, device).with_context(|| arg.name.clone())?;
+    Ok(Target { arg, fitted, prepared })
 }
 
 /// Latents `[frames, latent]` from an NPY file.
@@ -102,6 +117,6 @@ pub fn latents_npy(latents: &Latents) -> anyhow::Result<Vec<u8>> {
 
 /// Decode onto the target as BVH text, `frame_time` seconds per frame.
 pub fn decode_bvh(model: &Frozen, latents: &Latents, target: &Target, frame_time: f64, device: &Device) -> anyhow::Result<String> {
-    let motion = model.decode_motion(latents, &target.arg.skeleton, &target.prepared, frame_time, device).with_context(|| format!("decoding onto {}", target.arg.name))?;
+    let motion = model.decode_motion(latents, &target.fitted, &target.prepared, frame_time, device).with_context(|| format!("decoding onto {}", target.arg.name))?;
     Ok(bvh::write_string(&motion.to_bvh(&target.arg.skeleton)))
 }

@@ -100,7 +100,9 @@ EXAMPLES:
 /// depend on the skeleton; --decode-latent puts such a sequence on any --skeleton (a BVH, whose
 /// first frame is taken as its rest pose, or a skeleton document), zero-shot: the decoded
 /// motion starts where the target's rest pose stands, at its BVH's frame time (1/30 s for a
-/// document). Long clips go through the model in overlapping windows.
+/// document). Long clips go through the model in overlapping windows. A skeleton the model was
+/// trained on (its rigs.json) is read and written with its training rig, whatever clip of it is
+/// given: the rest pose its rotations were learned against.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-encode", version, after_long_help = EXAMPLES)]
 pub struct Args {
@@ -264,7 +266,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
     let model = super::latent::load_model(args.model.as_deref(), &device)?;
     let bytes = if args.latent {
         let [input] = args.inputs.as_slice() else { bail!("--latent encodes one BVH clip, {} given", args.inputs.len()) };
-        let clip = super::latent::read_source(input, &device)?;
+        let clip = super::latent::read_source(input, &model, &device)?;
         let latents = super::latent::encode(&model, &clip, &device)?;
         if args.common.output.as_deref().is_none_or(is_dash) && std::io::stdout().is_terminal() {
             bail!("refusing to write binary NPY to a terminal: redirect stdout or give -o FILE");
@@ -278,7 +280,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         };
         let latents = super::latent::read_latents(&input)?;
         let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
-        let target = super::latent::read_target(skeleton, &device)?;
+        let target = super::latent::read_target(skeleton, &model, &device)?;
         let frame_time = target.arg.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
         super::latent::decode_bvh(&model, &latents, &target, frame_time, &device)?.into_bytes()
     };

@@ -310,10 +310,18 @@ fn run_physics(args: &Args, inputs: &[PathBuf], opts: &PhysicsOptions) -> anyhow
 }
 
 fn run_reconstruction(args: &Args, reference: &Path, result: &Path, height: Option<f64>) -> anyhow::Result<Value> {
-    let a = load_one(args, reference)?;
+    let mut a = load_one(args, reference)?;
     let b = load_one(args, result)?;
     if a.skeleton.len() != b.skeleton.len() {
         bail!("{} has {} joints but {} has {}: reconstruction compares motions on one skeleton", a.name, a.skeleton.len(), b.name, b.skeleton.len());
+    }
+    // Features (and latents) of an F-frame clip describe F - 1 frames: the last one only gives
+    // velocities. So every encode -> decode round trip is one frame short; compare what it has.
+    if b.motion.frames + 1 == a.motion.frames {
+        if !args.common.quiet {
+            eprintln!("mo-metrics: note: {} has one frame fewer than {} (a decoded round trip); comparing its {} frames", b.name, a.name, b.motion.frames);
+        }
+        a.motion = a.motion.first_frames(b.motion.frames);
     }
     if a.motion.frames != b.motion.frames {
         bail!("{} has {} frames but {} has {}: reconstruction compares frame by frame", a.name, a.motion.frames, b.name, b.motion.frames);

@@ -54,8 +54,9 @@ EXAMPLES:
 /// --method latent (SATA, zero-shot): the source is encoded by the latent model (--model, or
 /// the built-in one trained on the synthetic zoo) into one vector per frame and decoded onto
 /// the target skeleton (--to, a BVH or skeleton document, or the first of TARGETS), conditioned
-/// only on its rest pose, topology and joint names. No example clips and no binding; the
-/// output has the source's frame time and one frame fewer than the source.
+/// only on its rest pose, topology and joint names (a skeleton the model was trained on keeps
+/// its training rig and rest pose, from the model's rigs.json). No example clips and no
+/// binding; the output has the source's frame time and one frame fewer than the source.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-retarget", version, after_long_help = EXAMPLES)]
 pub struct Args {
@@ -195,8 +196,8 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let device = candle_core::Device::Cpu;
     let model = super::latent::load_model(args.model.as_deref(), &device)?;
-    let source = super::latent::read_source(&args.source, &device)?;
-    let target = super::latent::read_target(&target_path, &device)?;
+    let source = super::latent::read_source(&args.source, &model, &device)?;
+    let target = super::latent::read_target(&target_path, &model, &device)?;
     let latents = super::latent::encode(&model, &source, &device)?;
     let text = super::latent::decode_bvh(&model, &latents, &target, source.motion.frame_time, &device)?;
     if args.report {

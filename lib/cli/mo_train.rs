@@ -482,6 +482,8 @@ fn run_sata(args: &Args) -> anyhow::Result<()> {
     if let Some(w) = args.lambda_cycle {
         info.weights.cycle = w;
     }
+    // Inference reads a trained skeleton's motion with the rig it was trained with.
+    sata::rigs::KnownRigs::of_set(&set).write(&args.out)?;
     let first = info.step;
     let vars = named_vars(&varmap);
     let mut trainer = SataTrainer { args, info, varmap, model, vars, opt, set, device };

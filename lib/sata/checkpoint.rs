@@ -2,6 +2,7 @@
 //! `model.safetensors`, `optimizer.safetensors`, `checkpoint.json` (format `menagerie.sata`),
 //! written atomically, resumable.
 
+use super::rigs::KnownRigs;
 use super::train::{FeatureScale, LossWeights};
 use super::{SataConfig, SataModel};
 use crate::diffusion::checkpoint::{fill_vars, read_dir_files};
@@ -70,17 +71,23 @@ pub fn load(dir: &Path, device: &Device) -> anyhow::Result<Loaded> {
 pub struct Frozen {
     pub info: SataInfo,
     pub model: SataModel,
+    /// The rigs of the skeletons it was trained on (empty for models from before `rigs.json`).
+    pub rigs: KnownRigs,
 }
 
-pub fn frozen_bytes(json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Frozen> {
+/// `rigs`: the contents of `rigs.json`, if the model has one.
+pub fn frozen_bytes(json: &[u8], weights: &[u8], rigs: Option<&[u8]>, device: &Device) -> anyhow::Result<Frozen> {
     let info = parse_info(json)?;
     let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
     let model = SataModel::new(vb, &info.config).context("model.safetensors does not match checkpoint.json's config")?;
-    Ok(Frozen { info, model })
+    let rigs = rigs.map(KnownRigs::parse).transpose()?.unwrap_or_default();
+    Ok(Frozen { info, model, rigs })
 }
 
 pub fn frozen(dir: &Path, device: &Device) -> anyhow::Result<Frozen> {
     let (json, weights) = read_dir_files(dir)?;
-    frozen_bytes(&json, &weights, device).with_context(|| format!("model {}", dir.display()))
+    let mut model = frozen_bytes(&json, &weights, None, device).with_context(|| format!("model {}", dir.display()))?;
+    model.rigs = KnownRigs::read(dir)?;
+    Ok(model)
 }

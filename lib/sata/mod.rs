@@ -28,6 +28,7 @@ pub mod checkpoint;
 pub mod graph;
 pub mod infer;
 pub mod model;
+pub mod rigs;
 pub mod train;
 
 pub use graph::SkeletonGraph;
