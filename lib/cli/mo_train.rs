@@ -445,7 +445,10 @@ fn run_sata(args: &Args) -> anyhow::Result<()> {
             eprintln!("mo-train: note: --batch, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
         }
         let set = training_set(args, loaded.info.seed, topology::DEFAULT_DMAX)?;
-        (loaded.varmap, loaded.model, opt, loaded.info, set)
+        // The checkpoint records the settings its latest steps ran with (a curriculum changes
+        // --augment or --lr between resumes; log.jsonl keeps the step-by-step history).
+        let info = SataInfo { lr: args.lr, batch: args.batch as usize, augment: args.augment, augment_variants: args.augment_variants as usize, ..loaded.info };
+        (loaded.varmap, loaded.model, opt, info, set)
     } else {
         if args.out.join("checkpoint.json").exists() {
             bail!("{} already holds a checkpoint: --resume to continue it, or choose another --out", args.out.display());
