@@ -122,8 +122,13 @@ pub fn same_skeleton(a: &Skeleton, b: &Skeleton) -> bool {
         return false;
     }
     let size = a.rest_extent().max(b.rest_extent());
+    offsets_agree(size, a.joints.iter().map(|j| j.offset), b.joints.iter().map(|j| j.offset))
+}
+
+/// Non-root rest offsets (joint 0 first in both) within `OFFSET_TOLERANCE` of `size`.
+pub fn offsets_agree(size: f64, a: impl Iterator<Item = glam::DVec3>, b: impl Iterator<Item = glam::DVec3>) -> bool {
     let tolerance = if size.is_finite() && size > 0.0 { OFFSET_TOLERANCE * size } else { 0.0 };
-    a.joints.iter().zip(&b.joints).skip(1).all(|(x, y)| (x.offset - y.offset).abs().max_element() <= tolerance)
+    a.zip(b).skip(1).all(|(x, y)| (x - y).abs().max_element() <= tolerance)
 }
 
 /// The folder part of a clip name ("" when none).

@@ -9,7 +9,7 @@
 //! ground; with its training rig, from `Chicken_TPOSE.bvh`, it stands and steps). So the model
 //! keeps each trained skeleton's rig, and inference uses it whenever the skeleton matches.
 
-use crate::diffusion::data::{TrainSet, OFFSET_TOLERANCE};
+use crate::diffusion::data::{offsets_agree, TrainSet};
 use crate::document::AnyTopSection;
 use crate::skeleton::Skeleton;
 use anyhow::{bail, Context};
@@ -43,16 +43,14 @@ impl KnownRig {
         }
     }
 
-    /// Same joint names and parents, and non-root offsets within `OFFSET_TOLERANCE` of the
-    /// skeleton's size (the test `diffusion::data::same_skeleton` groups training clips by).
+    /// Same joint names and parents, and non-root offsets within the tolerance training groups
+    /// clips by (`diffusion::data::same_skeleton`).
     pub fn matches(&self, s: &Skeleton) -> bool {
         if self.joints.len() != s.len() || self.offsets.len() != s.len() {
             return false;
         }
         let same_graph = s.joints.iter().zip(&self.joints).zip(&self.parents).all(|((j, n), p)| &j.name == n && &j.parent == p);
-        let size = s.rest_extent();
-        let tolerance = if size.is_finite() && size > 0.0 { OFFSET_TOLERANCE * size } else { 0.0 };
-        same_graph && s.joints.iter().zip(&self.offsets).skip(1).all(|(j, o)| (j.offset - glam::DVec3::from_array(*o)).abs().max_element() <= tolerance)
+        same_graph && offsets_agree(s.rest_extent(), s.joints.iter().map(|j| j.offset), self.offsets.iter().map(|o| glam::DVec3::from_array(*o)))
     }
 }
 
@@ -123,6 +121,7 @@ impl KnownRigs {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diffusion::data::OFFSET_TOLERANCE;
     use crate::synth;
 
     fn known(name: &str) -> (Skeleton, KnownRigs) {
