@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, mo_dift};
+use menagerie::cli::{self, mo_dift};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_dift::Args::parse();
-    finish("mo-dift", mo_dift::run(&args))
+    cli::main::<mo_dift::Args>("mo-dift", mo_dift::run)
 }

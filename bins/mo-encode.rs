@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, mo_encode};
+use menagerie::cli::{self, mo_encode};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_encode::Args::parse();
-    finish("mo-encode", mo_encode::run(&args))
+    cli::main::<mo_encode::Args>("mo-encode", mo_encode::run)
 }

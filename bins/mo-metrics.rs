@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, mo_metrics};
+use menagerie::cli::{self, mo_metrics};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_metrics::Args::parse();
-    finish("mo-metrics", mo_metrics::run(&args))
+    cli::main::<mo_metrics::Args>("mo-metrics", mo_metrics::run)
 }

@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, mo_render};
+use menagerie::cli::{self, mo_render};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_render::Args::parse();
-    finish("mo-render", mo_render::run(&args))
+    cli::main::<mo_render::Args>("mo-render", mo_render::run)
 }

@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, mo_retarget};
+use menagerie::cli::{self, mo_retarget};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_retarget::Args::parse();
-    finish("mo-retarget", mo_retarget::run(&args))
+    cli::main::<mo_retarget::Args>("mo-retarget", mo_retarget::run)
 }

@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, mo_sample};
+use menagerie::cli::{self, mo_sample};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_sample::Args::parse();
-    finish("mo-sample", mo_sample::run(&args))
+    cli::main::<mo_sample::Args>("mo-sample", mo_sample::run)
 }

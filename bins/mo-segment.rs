@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, mo_segment};
+use menagerie::cli::{self, mo_segment};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_segment::Args::parse();
-    finish("mo-segment", mo_segment::run(&args))
+    cli::main::<mo_segment::Args>("mo-segment", mo_segment::run)
 }

@@ -1,8 +1,10 @@
-use clap::Parser;
-use menagerie::cli::mo_train;
+use menagerie::cli::{self, mo_train};
 
 fn main() -> std::process::ExitCode {
-    let args = mo_train::Args::parse();
-    // Not `cli::finish`: an interrupted run exits 130, not 2.
+    let args = match cli::parse::<mo_train::Args>("mo-train") {
+        Ok(a) => a,
+        Err(code) => return code,
+    };
+    // Not `cli::main`: mo-train owns Ctrl-C (it checkpoints) and an interrupted run exits 130.
     mo_train::main(&args)
 }

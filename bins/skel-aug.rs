@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, skel_aug};
+use menagerie::cli::{self, skel_aug};
 
 fn main() -> std::process::ExitCode {
-    let args = skel_aug::Args::parse();
-    finish("skel-aug", skel_aug::run(&args))
+    cli::main::<skel_aug::Args>("skel-aug", skel_aug::run)
 }

@@ -1,7 +1,5 @@
-use clap::Parser;
-use menagerie::cli::{finish, skel_info};
+use menagerie::cli::{self, skel_info};
 
 fn main() -> std::process::ExitCode {
-    let args = skel_info::Args::parse();
-    finish("skel-info", skel_info::run(&args))
+    cli::main::<skel_info::Args>("skel-info", skel_info::run)
 }

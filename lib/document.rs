@@ -10,7 +10,7 @@
 use crate::bvh::Channel;
 use crate::bvh::Bvh;
 use crate::motion::Motion;
-use crate::repr::anytop::{AnyTopError, AnyTopOptions, AnyTopRig, AnyTopStats, RestSource};
+use crate::repr::anytop::{AnyTopError, AnyTopOptions, AnyTopRig, AnyTopStats, RestSource, FEATURE_DIMS};
 use crate::skeleton::names::{self, Side};
 use crate::skeleton::roles::{self, FootRule};
 use crate::skeleton::{topology, Joint, Skeleton, Stats};
@@ -60,6 +60,23 @@ impl AnyTopSection {
         let row = rig.rest_features(skeleton, rest)?;
         let rest_row = (0..row.joints).map(|j| row.at(0, j).to_vec()).collect();
         Ok(AnyTopSection { rig, rest_row, stats: None })
+    }
+
+    /// Whether the record fits `skeleton`: the rig, one rest-row entry of 13 finite numbers per
+    /// joint, and the statistics.
+    pub fn check(&self, skeleton: &Skeleton) -> Result<(), AnyTopError> {
+        self.rig.check(skeleton)?;
+        let n = skeleton.len();
+        if self.rest_row.len() != n {
+            return Err(AnyTopError::JointCount { what: "the rest-pose row (rest_row)", got: self.rest_row.len(), expected: n });
+        }
+        if let Some(j) = self.rest_row.iter().position(|r| r.len() != FEATURE_DIMS || r.iter().any(|v| !v.is_finite())) {
+            return Err(AnyTopError::BadRig(format!("rest_row entry {j} is not {FEATURE_DIMS} finite numbers")));
+        }
+        if let Some(stats) = &self.stats {
+            stats.check(n)?;
+        }
+        Ok(())
     }
 
     /// The record of a lone clip: the rig on its own first two frames (AnyTop's rule without a
@@ -162,10 +179,19 @@ pub enum DocumentError {
     Version { format: String, version: u32 },
     #[error("joint {joint} '{name}': {what}")]
     Joint { joint: usize, name: String, what: String },
-    #[error("{0}")]
+    #[error("joint_count is {count} but the document lists {joints} joints")]
+    JointCount { count: usize, joints: usize },
+    // Transparent and source-less: `{:#}` would print the inner message twice otherwise.
+    #[error(transparent)]
     Skeleton(#[from] crate::skeleton::SkeletonError),
     #[error("its AnyTop record does not fit the skeleton: {0}")]
-    AnyTop(#[from] AnyTopError),
+    AnyTop(AnyTopError),
+}
+
+impl From<AnyTopError> for DocumentError {
+    fn from(e: AnyTopError) -> DocumentError {
+        DocumentError::AnyTop(e)
+    }
 }
 
 impl SkeletonDocument {
@@ -230,9 +256,12 @@ impl SkeletonDocument {
         if doc.format != FORMAT || doc.version != FORMAT_VERSION {
             return Err(DocumentError::Version { format: doc.format, version: doc.version });
         }
+        if doc.joint_count != doc.joints.len() {
+            return Err(DocumentError::JointCount { count: doc.joint_count, joints: doc.joints.len() });
+        }
         let skeleton = doc.skeleton()?;
         if let Some(section) = &doc.anytop {
-            section.rig.check(&skeleton)?;
+            section.check(&skeleton)?;
         }
         Ok(doc)
     }
@@ -244,7 +273,11 @@ impl SkeletonDocument {
             let bad = |what: String| DocumentError::Joint { joint: j, name: e.name.clone(), what };
             let mut channels = Vec::with_capacity(e.channels.len());
             for c in &e.channels {
-                channels.push(Channel::from_name(c).ok_or_else(|| bad(format!("unknown channel '{c}'")))?);
+                let channel = Channel::from_name(c).ok_or_else(|| bad(format!("unknown channel '{c}'")))?;
+                if channels.contains(&channel) {
+                    return Err(bad(format!("channel '{c}' is listed twice")));
+                }
+                channels.push(channel);
             }
             if e.offset.iter().chain(e.end_sites.iter().flatten()).any(|v| !v.is_finite()) {
                 return Err(bad("non-finite offset".into()));

@@ -5,6 +5,7 @@
 
 pub mod augment;
 pub mod binding;
+pub mod budget;
 pub mod bvh;
 pub mod cli;
 pub mod diffusion;

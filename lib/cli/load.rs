@@ -104,7 +104,20 @@ impl Decoder {
         }
     }
 
+    /// Decode sample `i`; a motion with a NaN or an infinity (a placement or features too large
+    /// to pose) is an error, never a BVH that no reader takes.
     pub fn decode(&self, i: usize, features: &Features, skeleton: &Skeleton) -> Result<Motion, String> {
+        let motion = self.decode_unchecked(i, features, skeleton)?;
+        match motion.first_non_finite() {
+            Some((frame, joint)) => Err(format!(
+                "decoding gives a non-finite pose at frame {frame}, joint {joint} '{}' (the features or the placement hold numbers too large)",
+                skeleton.joints.get(joint).map_or("?", |j| j.name.as_str())
+            )),
+            None => Ok(motion),
+        }
+    }
+
+    fn decode_unchecked(&self, i: usize, features: &Features, skeleton: &Skeleton) -> Result<Motion, String> {
         match self {
             Decoder::M2m => m2m::decode(features, skeleton).map_err(|e| e.to_string()),
             Decoder::AnyTop { rig, stats, placements, from } => {
@@ -147,6 +160,9 @@ fn check_anytop(features: &Features, skeleton: &Skeleton) -> Result<(), (String,
 /// Rank 3 -> one motion; rank 4 -> one per sample (`true`: the input was a batch).
 pub fn split_samples(array: NpyArray, name: &str) -> anyhow::Result<(Vec<Features>, bool)> {
     match array.shape.as_slice() {
+        shape if shape.len() >= 3 && shape[shape.len() - 3] == 0 => {
+            bail!("{name}: the features hold no frames (shape {shape:?})")
+        }
         &[frames, joints, dims] => Ok((vec![Features { frames, joints, dims, data: array.data }], false)),
         &[n, frames, joints, dims] => {
             if n == 0 {
@@ -243,7 +259,7 @@ pub fn load_motions(inputs: &[PathBuf], options: &LoadOptions) -> anyhow::Result
     let read_one = |path: &PathBuf| -> anyhow::Result<Vec<Loaded>> {
         let name = io::display_name(path);
         let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-        if bytes.starts_with(b"\x93NUMPY") {
+        if npy::looks_like_npy(path, &bytes) {
             let path = options.skeleton.with_context(|| format!("{name} is an NPY feature file: give --skeleton (a skeleton document or BVH) to decode it"))?;
             let arg = match skeleton.get_or_init(|| read_skeleton(path).map_err(|e| format!("{e:#}"))) {
                 Ok(arg) => arg,

@@ -1,7 +1,8 @@
 //! `mo-dift`: diffusion features of a motion, and joint and frame correspondence from them.
 
 use crate::binding::auto;
-use crate::cli::load::{expand_inputs, is_dash, load_motions, LoadOptions, Loaded};
+use crate::cli::bounds;
+use crate::cli::load::{expand_inputs, load_motions, LoadOptions, Loaded};
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint::{self, Frozen};
 use crate::diffusion::Schedule;
@@ -75,10 +76,10 @@ pub struct Args {
     #[arg(long, value_name = "R", default_value_t = 0.061, requires = "as_binding")]
     pub bind_rate: f64,
     /// Diffusion step the motion is noised to (0..T-1) [default: joints 2, otherwise 3].
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", value_parser = bounds::count(0, bounds::MAX_DIFFUSION_T))]
     pub t: Option<usize>,
     /// Layer whose activations are read (0-based) [default: joints 0, otherwise 1].
-    #[arg(long, value_name = "L")]
+    #[arg(long, value_name = "L", value_parser = bounds::count(0, bounds::MAX_LAYER))]
     pub layer: Option<usize>,
     /// Noise draws averaged.
     #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u64).range(1..=256))]
@@ -125,9 +126,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let features: Vec<DiftFeatures> = motions.iter().map(|m| features_of(&model, m, &opts, &device)).collect::<anyhow::Result<_>>()?;
     let bytes = if !pairwise {
         let f = &features[0];
-        if args.common.output.as_deref().is_none_or(is_dash) && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
-            bail!("refusing to write NPY to a terminal: redirect stdout or give -o FILE");
-        }
+        io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout or give -o FILE")?;
         let mut bytes = Vec::new();
         npy::write_f32_parts(&mut bytes, &[f.tokens, f.joints, f.width], &[f.data.as_slice()]).context("building the NPY")?;
         bytes
@@ -170,7 +169,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         };
         text.into_bytes()
     };
-    io::write_output(args.common.output.as_deref(), &bytes).context("cannot write the output")
+    Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
 
 /// One skeleton in two files: the same joints (names and parents) in the same order; bone

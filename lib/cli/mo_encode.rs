@@ -34,7 +34,6 @@ use crate::skeleton::{lookup, topology, Skeleton};
 use crate::{bvh, io};
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 const EXAMPLES: &str = "\
@@ -268,9 +267,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         let [input] = args.inputs.as_slice() else { bail!("--latent encodes one BVH clip, {} given", args.inputs.len()) };
         let clip = super::latent::read_source(input, &model, &device)?;
         let latents = super::latent::encode(&model, &clip, &device)?;
-        if args.common.output.as_deref().is_none_or(is_dash) && std::io::stdout().is_terminal() {
-            bail!("refusing to write binary NPY to a terminal: redirect stdout or give -o FILE");
-        }
+        io::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
         super::latent::latents_npy(&latents)?
     } else {
         let input = match args.inputs.as_slice() {
@@ -284,7 +281,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         let frame_time = target.arg.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
         super::latent::decode_bvh(&model, &latents, &target, frame_time, &device)?.into_bytes()
     };
-    io::write_output(args.common.output.as_deref(), &bytes).context("cannot write the output")
+    Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
 
 /// AnyTop's flags mean nothing to m2m (clap cannot tie a flag to another flag's value).
@@ -424,7 +421,7 @@ fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
             eprintln!("mo-encode: {}: {} frames, {j} joints -> m2m features [{n}, {j}, {d}]", clip.name, clip.motion.frames);
         }
     }
-    write_outputs(vec![(args.common.output.clone(), npy_bytes(&features)?)])
+    write_outputs(vec![(args.common.output.clone(), npy_bytes(clips, &features)?)])
 }
 
 /// What m2m loses on this clip, as a warning (None when nothing).
@@ -456,7 +453,15 @@ fn check_stackable(clips: &[Clip], features: &[Features]) -> anyhow::Result<()> 
 }
 
 /// One NPY of all clips: rank 3 for one, rank 4 for a batch.
-fn npy_bytes(features: &[Features]) -> anyhow::Result<Vec<u8>> {
+fn npy_bytes(clips: &[Clip], features: &[Features]) -> anyhow::Result<Vec<u8>> {
+    // float32 features hold what a motion's f64 numbers became: 1e300 is inf there.
+    for (clip, f) in clips.iter().zip(features) {
+        if let Some((frame, joint, dim)) = f.first_non_finite() {
+            let value = f.at(frame, joint)[dim];
+            let joint_name = clip.skeleton.joints.get(joint).map_or("?", |j| j.name.as_str());
+            bail!("{}: encodes to {value} at feature frame {frame}, joint {joint} '{joint_name}', dim {dim}: the motion holds numbers too large for float32 features", clip.name);
+        }
+    }
     let mut shape = features[0].shape().to_vec();
     if features.len() > 1 {
         shape.insert(0, features.len());
@@ -561,7 +566,7 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
         }
     }
 
-    let mut outputs = vec![(args.common.output.clone(), npy_bytes(&features)?)];
+    let mut outputs = vec![(args.common.output.clone(), npy_bytes(clips, &features)?)];
     if let Some(path) = &args.stats {
         let stats = clip_stats.as_ref().expect("computed for --stats");
         outputs.push((Some(path.clone()), json_line(stats)?));
@@ -631,32 +636,12 @@ fn read_placements(path: &Path, samples: usize, npy_name: &str) -> anyhow::Resul
 /// Write every output or none: files atomically, stdout last (it cannot be taken back); when a
 /// file cannot be written, the files of this call already written are removed.
 fn write_outputs(outputs: Vec<(Option<PathBuf>, Vec<u8>)>) -> anyhow::Result<()> {
-    let (to_stdout, to_files): (Vec<_>, Vec<_>) =
-        outputs.into_iter().partition(|(p, _)| p.as_deref().is_none_or(is_dash));
-    let mut written: Vec<PathBuf> = Vec::new();
-    for (path, bytes) in to_files {
-        let path = path.expect("partitioned: a file");
-        if let Err(e) = io::write_atomic(&path, &bytes) {
-            for p in &written {
-                let _ = std::fs::remove_file(p);
-            }
-            return Err(e).with_context(|| format!("cannot write {}", path.display()));
-        }
-        written.push(path);
-    }
-    for (_, bytes) in to_stdout {
-        io::write_output(None, &bytes).context("cannot write stdout")?;
-    }
-    Ok(())
+    Ok(io::write_all(&outputs.iter().map(|(p, b)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?)
 }
 
 /// Binary on a terminal is never what anyone wants (and can upset it).
 fn refuse_terminal(output: Option<&Path>) -> anyhow::Result<()> {
-    let to_stdout = output.is_none_or(is_dash);
-    if to_stdout && std::io::stdout().is_terminal() {
-        bail!("refusing to write a binary NPY to a terminal: use -o FILE.npy or a pipe");
-    }
-    Ok(())
+    Ok(io::refuse_terminal(output, "a binary NPY", "use -o FILE.npy or a pipe")?)
 }
 
 /// The AnyTop record `--skeleton` stands for, the same way when encoding and decoding: the

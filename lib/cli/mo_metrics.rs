@@ -5,6 +5,7 @@
 //! Definitions and deviations: docs/metrics.md.
 
 use crate::binding::Binding;
+use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, read_skeleton, DecodeFrom, LoadOptions, Loaded};
 use crate::cli::CommonOpts;
 use crate::document::AnyTopSection;
@@ -94,13 +95,13 @@ pub enum Command {
         #[arg(long = "gen", value_name = "PATH", required = true, num_args = 1..)]
         generated: Vec<PathBuf>,
         /// Window length of coverage and local diversity, in frames.
-        #[arg(long, value_name = "FRAMES", default_value_t = 15)]
+        #[arg(long, value_name = "FRAMES", default_value_t = 15, value_parser = bounds::count(0, bounds::MAX_FRAMES))]
         window: usize,
         /// Coverage threshold on the mean joint distance (AnyTop's units).
         #[arg(long, value_name = "D", default_value_t = 0.349)]
         threshold: f64,
         /// Shortest segment of the global-diversity segmentation, in frames.
-        #[arg(long, value_name = "FRAMES", default_value_t = 30)]
+        #[arg(long, value_name = "FRAMES", default_value_t = 30, value_parser = bounds::count(0, bounds::MAX_FRAMES))]
         min_segment: usize,
     },
     /// Motion2Motion's transfer metrics: results against their source and the target's examples.
@@ -132,7 +133,7 @@ pub enum Command {
         seconds: Option<f64>,
         /// Cut examples and results into windows of this many frames for the FIDs (a set of
         /// one or two clips has no covariance; the windows make sets). 0 = whole clips.
-        #[arg(long, value_name = "FRAMES", default_value_t = 0)]
+        #[arg(long, value_name = "FRAMES", default_value_t = 0, value_parser = bounds::count(0, bounds::MAX_FRAMES))]
         fid_window: usize,
     },
     /// SATA's reconstruction metrics: a result against a reference motion on the same skeleton.
@@ -241,7 +242,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Format::Json => serde_json::to_string_pretty(&report).context("building the JSON")? + "\n",
         Format::Table => table(&report),
     };
-    io::write_output(args.common.output.as_deref(), text.as_bytes()).context("cannot write the report")
+    Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
 fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -> anyhow::Result<PhysicsOptions> {

@@ -191,8 +191,8 @@ fn outputs(args: &Args) -> anyhow::Result<Vec<(Kind, Option<PathBuf>)>> {
     if out.iter().filter(|(_, p)| p.is_none()).count() > 1 {
         bail!("only one picture can go to stdout");
     }
-    if out.iter().any(|(_, p)| p.is_none()) && std::io::IsTerminal::is_terminal(&std::io::stdout()) && !matches!(out.iter().find(|(_, p)| p.is_none()), Some((Kind::Html, _))) {
-        bail!("refusing to write a binary picture to a terminal: give a file (--sheet out.png, -o out.gif) or redirect stdout");
+    if let Some((kind, _)) = out.iter().find(|(_, p)| p.is_none()).filter(|(k, _)| *k != Kind::Html) {
+        io::refuse_terminal(None, if *kind == Kind::Sheet { "a PNG" } else { "a GIF" }, "give a file (--sheet out.png, -o out.gif) or redirect stdout")?;
     }
     Ok(out)
 }
@@ -254,6 +254,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if loaded.is_empty() {
         bail!("no motion to draw");
     }
+    if let Some((FrameLabels::Segments(segments), file)) = &frame_labels {
+        // Segments are frames of the drawn motions: one past the longest is a label file
+        // for another motion.
+        let longest = loaded.iter().map(|l| l.motion.frames).max().unwrap_or(0);
+        if let Some((i, (_, end, _))) = segments.iter().enumerate().find(|(_, (_, end, _))| *end > longest) {
+            bail!("{file}: segment {i} ends at frame {end}, but the longest motion has {longest} frames");
+        }
+    }
     let (first_frame, mut tracks) = tracks(&loaded, args.frames)?;
     let skeletons: Vec<_> = loaded.iter().map(|l| &l.skeleton).collect();
     let legend = labels::apply(
@@ -270,9 +278,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let bytes = draw(kind, &tracks, &legend, framing, args)?;
         pictures.push((bytes, path, kind));
     }
+    // All pictures or none.
+    io::write_all(&pictures.iter().map(|(b, p, _)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?;
     for (bytes, path, kind) in &pictures {
         let target = path.as_ref().map_or("stdout".to_string(), |p| p.display().to_string());
-        io::write_output(path.as_deref(), bytes).with_context(|| format!("cannot write {target}"))?;
         if args.common.verbose {
             eprintln!("mo-render: wrote {kind:?} ({} bytes, {} motion(s)) to {target}", bytes.len(), tracks.len());
         }

@@ -5,6 +5,7 @@
 
 use crate::binding::auto::{self, AutoOptions, Body};
 use crate::binding::{Binding, JointMap};
+use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, is_dash};
 use crate::cli::CommonOpts;
 use crate::document::AnyTopSection;
@@ -81,7 +82,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
     /// Binding rate of --bind auto: 2 x pairs / (source joints + target joints).
-    #[arg(long, value_name = "R", default_value_t = 0.061)]
+    #[arg(long, value_name = "R", default_value_t = 0.061, value_parser = bounds::positive(1.0))]
     pub bind_rate: f64,
     /// Print the binding (JSON) and stop.
     #[arg(long)]
@@ -90,10 +91,10 @@ pub struct Args {
     #[arg(short = 'n', long = "samples", value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub samples: u64,
     /// Output length in frames [default: the source's, after resampling].
-    #[arg(long, value_name = "N", conflicts_with = "seconds")]
+    #[arg(long, value_name = "N", conflicts_with = "seconds", value_parser = bounds::count(1, bounds::MAX_FRAMES))]
     pub frames: Option<usize>,
     /// Output length in seconds.
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", value_parser = bounds::positive(bounds::MAX_SECONDS))]
     pub seconds: Option<f64>,
     /// Key-frame mode: the source counts only at these frames (comma-separated, source frames).
     #[arg(long, value_name = "F,F,...", value_delimiter = ',')]
@@ -102,13 +103,13 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = OutFormat::Bvh)]
     pub format: OutFormat,
     /// Patch length in frames (paper: 11).
-    #[arg(long, value_name = "FRAMES")]
+    #[arg(long, value_name = "FRAMES", value_parser = bounds::count(1, bounds::MAX_PATCH))]
     pub patch: Option<usize>,
     /// Weight of the bound (source) channels in matching, 0..1 (paper: 0.85).
     #[arg(long, value_name = "A")]
     pub alpha: Option<f64>,
     /// Match-and-blend iterations per pyramid level (paper: 3).
-    #[arg(long, value_name = "L")]
+    #[arg(long, value_name = "L", value_parser = bounds::count(1, bounds::MAX_RETARGET_STEPS))]
     pub steps: Option<usize>,
     /// Scale between pyramid levels (paper: 0.75).
     #[arg(long, value_name = "S")]
@@ -212,7 +213,7 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
             started.elapsed().as_secs_f64()
         );
     }
-    io::write_output(args.common.output.as_deref(), text.as_bytes()).context("cannot write the output")
+    Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
 /// One read clip.
@@ -225,7 +226,7 @@ struct Clip {
 fn read_clip(path: &Path) -> anyhow::Result<Clip> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-    if bytes.starts_with(b"\x93NUMPY") {
+    if npy::looks_like_npy(path, &bytes) {
         bail!("{name}: mo-retarget reads BVH files (decode features first: mo-encode --decode)");
     }
     let parsed = bvh::parse_bytes(&bytes, &name)?;
@@ -299,8 +300,7 @@ fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Setti
     s.frames = match (args.frames, args.seconds) {
         (Some(0), _) => bail!("--frames must be at least 1"),
         (Some(n), _) => Some(n),
-        (None, Some(sec)) if sec.is_finite() && sec > 0.0 => Some(((sec * fps).round() as usize).max(1)),
-        (None, Some(sec)) => bail!("--seconds must be a positive number, found {sec}"),
+        (None, Some(sec)) => Some(bounds::frames_for_seconds(sec, fps).map_err(anyhow::Error::msg)?),
         (None, None) => None,
     };
     if let Some(keys) = &args.key_frames {
@@ -388,12 +388,23 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (binding.resolve(&name, &source.skeleton, &source.name, &first.skeleton, &first.name)?, binding)
     };
     if args.emit_binding {
-        return io::write_output(outputs[0].as_deref(), binding.to_json().as_bytes()).context("cannot write the binding");
+        return Ok(io::write_output(outputs[0].as_deref(), binding.to_json().as_bytes())?);
     }
 
     // Frame rates.
     let source_fps = 1.0 / source.motion.frame_time;
     let source_motion = if (source_fps - target_fps).abs() > 1e-6 * target_fps {
+        let frames = (source.motion.frames - 1) as f64 * source.motion.frame_time * target_fps + 1.0;
+        if !(frames <= bounds::MAX_FRAMES as f64) {
+            bail!(
+                "{}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps ({}: Frame Time {}) would give {frames:.0} frames, more than {}",
+                source.name,
+                first.name,
+                first.motion.frame_time,
+                bounds::MAX_FRAMES
+            );
+        }
+        crate::budget::check_motion(&format!("{}: resampling", source.name), frames as usize, source.skeleton.len())?;
         if !args.common.quiet {
             eprintln!("mo-retarget: {}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps", source.name);
         }
@@ -403,6 +414,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
 
     let settings = settings(args, target_fps, source_motion.frames)?;
+    let out_frames = settings.frames.unwrap_or(source_motion.frames);
+    if out_frames > bounds::MAX_FRAMES {
+        bail!("{}: {out_frames} output frames, more than {} (give --frames or --seconds)", source.name, bounds::MAX_FRAMES);
+    }
+    crate::budget::check_motion("the output", out_frames.saturating_mul(count), first.skeleton.len())?;
     let example_motions: Vec<Motion> = examples.iter().map(|e| e.motion.clone()).collect();
     let seeds: Vec<u64> = (0..count as u64).map(|i| args.common.seed.wrapping_add(i)).collect();
     let loaded = started.elapsed();
@@ -433,13 +449,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             files.push((outputs[0].clone(), bytes));
         }
     }
-    if std::io::IsTerminal::is_terminal(&std::io::stdout()) && args.format == OutFormat::Npy && files.iter().any(|(p, _)| p.is_none()) {
-        bail!("refusing to write NPY to a terminal: give -o FILE or redirect stdout");
+    if args.format == OutFormat::Npy {
+        io::refuse_terminal(outputs[0].as_deref(), "NPY", "give -o FILE or redirect stdout")?;
     }
-    for (path, bytes) in &files {
-        let target = path.as_ref().map_or("stdout".to_string(), |p| p.display().to_string());
-        io::write_output(path.as_deref(), bytes).with_context(|| format!("cannot write {target}"))?;
-    }
+    // All samples or none.
+    io::write_all(&files.iter().map(|(p, b)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?;
     let written = t1.elapsed();
 
     if args.report && !args.common.quiet {

@@ -1,6 +1,6 @@
 //! `mo-sample`: generate motion for any skeleton with a trained denoiser.
 
-use crate::cli::load::{is_dash, read_skeleton};
+use crate::cli::load::read_skeleton;
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
@@ -30,6 +30,9 @@ EXAMPLES:
 /// model's frame-to-frame jitter; measured against 3 and 6 Hz and the raw output in
 /// models/zoo-small/MODEL_CARD.md (at 6 Hz jerk stays up to 60x the clips').
 pub const DEFAULT_SMOOTH_HZ: f64 = 4.0;
+
+/// Frames per sample (`--frames`, `--seconds`): the denoiser attends over all frames at once.
+pub const MAX_SAMPLE_FRAMES: u64 = 10_000;
 
 /// The default `--blend`: half a second (15 frames at 30 fps), the order of a step.
 pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
@@ -92,10 +95,10 @@ pub struct Args {
     #[arg(short = 'n', long = "samples", value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub samples: u64,
     /// Frames per sample [default: 120; with --reference: the reference's length].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000), conflicts_with = "seconds")]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=MAX_SAMPLE_FRAMES), conflicts_with = "seconds")]
     pub frames: Option<u64>,
     /// Length in seconds (at the skeleton's frame rate).
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", value_parser = crate::cli::bounds::positive(crate::cli::bounds::MAX_SECONDS))]
     pub seconds: Option<f64>,
     /// Diffusion steps to visit (1..=100).
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=100))]
@@ -177,8 +180,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => None,
     };
     let frames = match args.seconds {
-        Some(s) if s.is_finite() && s > 0.0 => ((s * fps).round() as usize).max(1),
-        Some(s) => bail!("--seconds must be a positive number, found {s}"),
+        Some(s) => match crate::cli::bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
+            n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
+            n => n,
+        },
         None => match (args.frames, &reference) {
             (Some(n), _) => n as usize,
             (None, Some(r)) => r.features.frames,
@@ -200,7 +205,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         SamplerArg::Ddim => Sampler::Ddim,
     };
     let lambda = smoothing(args.smooth, fps)?;
-    if !(args.blend.is_finite() && args.blend >= 0.0) {
+    if !(args.blend.is_finite() && args.blend >= 0.0 && args.blend <= crate::cli::bounds::MAX_SECONDS) {
         bail!("--blend must be a duration in seconds (>= 0), found {}", args.blend);
     }
     let blend = (args.blend * fps).round() as usize;
@@ -251,19 +256,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 let motion = section.rig.decode_ik(skeleton, f, &placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
                 texts.push(bvh::write_string(&motion.to_bvh(skeleton)));
             }
-            for (p, t) in paths.iter().zip(texts) {
-                io::write_output(Some(p), t.as_bytes()).with_context(|| format!("cannot write {}", p.display()))?;
-            }
+            // All samples or none.
+            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_bytes())).collect::<Vec<_>>())?;
         }
         None => {
-            if args.common.output.as_deref().is_none_or(is_dash) && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
-                bail!("refusing to write NPY to a terminal: redirect stdout, or give -o FILE or --bvh PATTERN");
-            }
+            io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
             let shape = [count, frames, skeleton.len(), FEATURE_DIMS];
             let parts: Vec<&[f32]> = samples.iter().map(|f| f.data.as_slice()).collect();
             let mut bytes = Vec::new();
             npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-            io::write_output(args.common.output.as_deref(), &bytes).context("cannot write the samples")?;
+            io::write_output(args.common.output.as_deref(), &bytes)?;
         }
     }
     Ok(())

@@ -4,7 +4,8 @@
 //! (`frame_features`: the place where feature providers plug in), runs `segment::segment`, and
 //! writes JSON that `mo-render --frame-labels` reads.
 
-use crate::cli::load::{read_skeleton, split_samples};
+use crate::cli::bounds;
+use crate::cli::load::{is_dash, read_skeleton, split_samples};
 use crate::cli::CommonOpts;
 use crate::diffusion::{checkpoint, Schedule};
 use crate::dift::{self, DiftOptions};
@@ -65,14 +66,14 @@ pub struct Args {
     #[arg(long, value_name = "K", default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=64))]
     pub k: u64,
     /// Principal components kept (0 = cluster the features as they are).
-    #[arg(long, value_name = "N", default_value_t = 8)]
+    #[arg(long, value_name = "N", default_value_t = 8, value_parser = bounds::count(0, bounds::MAX_PCA_DIMS))]
     pub pca_dims: usize,
     /// Temporal context: mean and std of each component over this many seconds around a frame
     /// (0 = single frames).
     #[arg(long, value_name = "SECONDS", default_value_t = 1.0, allow_negative_numbers = true)]
     pub window: f64,
     /// Shortest segment in frames; shorter runs are merged into their longer neighbour.
-    #[arg(long, value_name = "FRAMES", default_value_t = 10)]
+    #[arg(long, value_name = "FRAMES", default_value_t = 10, value_parser = bounds::count(0, bounds::MAX_MIN_SEGMENT))]
     pub min_segment: usize,
     /// What each frame is described by.
     #[arg(long, value_enum, value_name = "KIND", default_value_t = Features::Dift)]
@@ -81,10 +82,10 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
     /// With --features dift: diffusion step the motion is noised to.
-    #[arg(long, value_name = "T", default_value_t = DiftOptions::TEMPORAL.t)]
+    #[arg(long, value_name = "T", default_value_t = DiftOptions::TEMPORAL.t, value_parser = bounds::count(0, bounds::MAX_DIFFUSION_T))]
     pub t: usize,
     /// With --features dift: layer whose activations are read (0-based).
-    #[arg(long, value_name = "L", default_value_t = DiftOptions::TEMPORAL.layer)]
+    #[arg(long, value_name = "L", default_value_t = DiftOptions::TEMPORAL.layer, value_parser = bounds::count(0, bounds::MAX_LAYER))]
     pub layer: usize,
     /// With --features dift: noise draws averaged.
     #[arg(long, value_name = "N", default_value_t = DiftOptions::TEMPORAL.draws as u64, value_parser = clap::value_parser!(u64).range(1..=256))]
@@ -221,7 +222,7 @@ pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOpti
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads();
-    if !(args.window.is_finite() && args.window >= 0.0) {
+    if !(args.window.is_finite() && args.window >= 0.0 && args.window <= bounds::MAX_SECONDS) {
         bail!("--window must be a number of seconds >= 0, found {}", args.window);
     }
     let input = load(args)?;
@@ -247,19 +248,22 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     let text = report(args, &input, &options, &result)?;
-    io::write_output(args.common.output.as_deref(), text.as_bytes()).context("cannot write the segmentation")
+    Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
 /// Read the input: a BVH (features on a rig from its own first frames), or an NPY of AnyTop
 /// features taken as they are (checked against --skeleton when given).
 fn load(args: &Args) -> anyhow::Result<Input> {
+    if is_dash(&args.input) && args.skeleton.as_deref().is_some_and(is_dash) {
+        bail!("stdin ('-') can be read only once, but the input and --skeleton both read it");
+    }
     let name = io::display_name(&args.input);
     let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
     let skeleton = match &args.skeleton {
         Some(path) => Some(read_skeleton(path)?),
         None => None,
     };
-    if !bytes.starts_with(b"\x93NUMPY") {
+    if !npy::looks_like_npy(&args.input, &bytes) {
         let parsed = bvh::parse_bytes(&bytes, &name)?;
         drop(bytes);
         let own = Skeleton::from_bvh(&parsed);

@@ -1,5 +1,6 @@
 //! `mo-train`: train AnyTop's denoiser on folders of BVH clips, with checkpoints that resume.
 
+use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint::{self, CheckpointInfo, TrainedSkeleton};
@@ -69,7 +70,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Preset::Small)]
     pub preset: Preset,
     /// Training steps in total (a resumed run counts the steps already done).
-    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=bounds::MAX_TRAIN_STEPS))]
     pub steps: u64,
     /// Crops per step.
     #[arg(long, value_name = "N", default_value_t = 16, value_parser = clap::value_parser!(u64).range(1..=1024))]
@@ -84,20 +85,20 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Arch::Anytop)]
     pub arch: Arch,
     /// sata: weight of the KL term that keeps the latent near a unit Gaussian.
-    #[arg(long, value_name = "W", default_value_t = 1e-4)]
+    #[arg(long, value_name = "W", default_value_t = 1e-4, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
     pub lambda_kl: f64,
     /// sata: weight of the cross-skeleton latent cycle (a motion's latent decoded onto another
     /// training skeleton and encoded again should come back). Default 0 for a new run (tried
     /// at 1 for 1,100 steps: transfers moved less, models/zoo-sata/MODEL_CARD.md); a resumed
     /// run keeps its checkpoint's unless this is given.
-    #[arg(long, value_name = "W")]
+    #[arg(long, value_name = "W", value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
     pub lambda_cycle: Option<f64>,
     /// Learning rate.
-    #[arg(long, value_name = "LR", default_value_t = 1e-4)]
+    #[arg(long, value_name = "LR", default_value_t = 1e-4, value_parser = bounds::positive(1.0))]
     pub lr: f64,
     /// Weight of the geodesic rotation loss (the angle, in radians, between predicted and true
     /// joint rotations) next to the MSE; the reference trains with 1.
-    #[arg(long, value_name = "W", default_value_t = 1.0)]
+    #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
     pub lambda_geo: f64,
     /// Chance that a training draw uses an augmented skeleton (joints removed or added), as a
     /// number in [0, 1] or a fraction like 2/3.
@@ -107,7 +108,7 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = Augmentation::DEFAULT_VARIANTS as u64, value_parser = clap::value_parser!(u64).range(0..=64))]
     pub augment_variants: u64,
     /// Save a checkpoint at least this often.
-    #[arg(long, value_name = "MIN", default_value_t = 5.0)]
+    #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
     /// Continue from the checkpoint in --out.
     #[arg(long)]
@@ -197,7 +198,7 @@ fn catch_interrupts() -> anyhow::Result<()> {
         ctrlc::set_handler(|| {
             if STOP.swap(true, Ordering::SeqCst) && !SAVING.load(Ordering::SeqCst) {
                 eprintln!("\nmo-train: interrupted twice, quitting without saving (the last checkpoint is whole)");
-                std::process::exit(INTERRUPTED_EXIT as i32);
+                crate::io::output::remove_temps_and_exit(INTERRUPTED_EXIT as i32);
             }
         })
         .map_err(|e| e.to_string())
@@ -238,6 +239,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     crate::nn::keep_freed_memory();
     if !(args.lr.is_finite() && args.lr > 0.0) {
         bail!("--lr must be a positive number, found {}", args.lr);
+    }
+    // Before any work or message: --out must be (or become) a directory.
+    if args.out.exists() && !args.out.is_dir() {
+        bail!("--out {}: not a directory (the model directory to write)", args.out.display());
     }
     let say = |msg: String| {
         if !args.common.quiet {

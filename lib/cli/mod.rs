@@ -6,6 +6,7 @@
 //! first tool that has one, e.g. a metrics check). Errors print
 //! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
+pub mod bounds;
 pub mod docs;
 pub mod latent;
 pub mod load;
@@ -38,18 +39,61 @@ pub struct CommonOpts {
     /// Print more about what is happening on stderr.
     #[arg(short, long, global = true, conflicts_with = "quiet")]
     pub verbose: bool,
-    /// Worker threads (default: all cores). Output never depends on this.
-    #[arg(long, value_name = "N", global = true)]
+    /// Worker threads (default: all cores; at most 256). Output never depends on this.
+    #[arg(long, value_name = "N", global = true, value_parser = bounds::count(1, bounds::MAX_THREADS))]
     pub threads: Option<usize>,
 }
 
 impl CommonOpts {
-    /// Apply `--threads` to rayon's global pool (once per process).
+    /// Apply `--threads` to rayon's global pool (once per process; a second call, as in tests
+    /// that run tools in one process, keeps the pool there is).
     pub fn init_threads(&self) {
         if let Some(n) = self.threads {
-            let _ = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global();
+            let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
         }
     }
+}
+
+/// Parse a tool's arguments. `--help` and `--version` print as clap prints them; a usage
+/// error is one line, `tool: what went wrong (see --help)`, and exit code 2.
+pub fn parse<A: clap::Parser>(tool: &str) -> Result<A, ExitCode> {
+    A::try_parse().map_err(|e| {
+        use clap::error::ErrorKind;
+        match e.kind() {
+            ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                let _ = e.print();
+                ExitCode::SUCCESS
+            }
+            _ => {
+                eprintln!("{tool}: {} (see --help)", usage_line(&e));
+                ExitCode::from(2)
+            }
+        }
+    })
+}
+
+/// clap's message without its usage block and tips: the lines before the first blank one,
+/// joined, without the `error: ` prefix.
+fn usage_line(e: &clap::Error) -> String {
+    if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        return "a subcommand is required".to_string();
+    }
+    let text = e.render().to_string();
+    let lines: Vec<&str> = text.lines().map(str::trim).take_while(|l| !l.is_empty()).collect();
+    let line = lines.join(" ");
+    line.strip_prefix("error: ").unwrap_or(&line).trim_end_matches('.').to_string()
+}
+
+/// A whole tool: parse the arguments, remove temporary output files on Ctrl-C, SIGTERM and
+/// SIGHUP (then exit 130), run, and turn the result into an exit code.
+pub fn main<A: clap::Parser>(tool: &str, run: impl FnOnce(&A) -> anyhow::Result<()>) -> ExitCode {
+    let args = match parse::<A>(tool) {
+        Ok(a) => a,
+        Err(code) => return code,
+    };
+    // Fails only when a handler is already set (a test calling this twice): keep that one.
+    let _ = ctrlc::set_handler(|| crate::io::output::remove_temps_and_exit(130));
+    finish(tool, run(&args))
 }
 
 /// Run a tool's body and turn its result into an exit code, printing errors as one line.

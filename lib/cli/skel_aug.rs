@@ -64,14 +64,14 @@ pub struct Args {
     #[arg(long)]
     pub no_remove: bool,
     /// Insert N joints, each at the midpoint of a random bone (after any removal).
-    #[arg(long, value_name = "N", default_value_t = 0)]
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = crate::cli::bounds::count(0, crate::cli::bounds::MAX_ADD_JOINTS))]
     pub add: usize,
     /// Let removal take feet too (for bodies that lie on the ground, like snakes, whose joints
     /// are all feet; AnyTop does the same for its snakes).
     #[arg(long)]
     pub allow_feet: bool,
     /// Write K variants with different random choices (-o must then contain '{i}').
-    #[arg(short = 'n', long = "variants", value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(short = 'n', long = "variants", value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=crate::cli::bounds::MAX_VARIANTS))]
     pub variants: u64,
     /// Indent JSON output for humans (skeleton documents only).
     #[arg(long)]
@@ -101,12 +101,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     } else {
         Input::Bvh(bvh::parse_bytes(&bytes, &name)?)
     };
+    // Every variant is held until all are written (all or nothing); each has its frames.
+    crate::budget::check("the variants' text", count as u128 * (bytes.len() as u128 + 64 * args.add as u128), 2)?;
+    if let Input::Bvh(b) = &input {
+        crate::budget::check_motion(&format!("{name}: the augmented motion"), b.frames, b.joints.len() + args.add)?;
+    }
     let skeleton = match &input {
         Input::Bvh(b) => Skeleton::from_bvh(b),
         Input::Document(d) => d.skeleton().map_err(|e| anyhow::anyhow!("{name}: {e}"))?,
     };
 
     let mut warned = BTreeSet::new();
+    let mut texts = Vec::with_capacity(outputs.len());
     for (i, out) in outputs.iter().enumerate() {
         let mut rng = variant_rng(args.common.seed, i);
         let plan = augment::plan(&skeleton, &options, &mut rng);
@@ -133,9 +139,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 json
             }
         };
-        io::write_output(out.as_deref(), text.as_bytes()).with_context(|| format!("cannot write {target}"))?;
+        texts.push(text);
     }
-    Ok(())
+    // All variants or none.
+    let files: Vec<(Option<&Path>, &[u8])> = outputs.iter().zip(&texts).map(|(p, t)| (p.as_deref(), t.as_bytes())).collect();
+    Ok(io::write_all(&files)?)
 }
 
 fn options(args: &Args) -> anyhow::Result<augment::Options> {

@@ -71,6 +71,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let name = io::display_name(path);
             let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
             let parsed = bvh::parse_bytes(&bytes, &name)?;
+            if parsed.frames == 0 {
+                anyhow::bail!("--rest-pose {name}: the file has no frames (the rest pose is its frame 0)");
+            }
             let skeleton = Skeleton::from_bvh(&parsed);
             Some((name, skeleton.clone(), Motion::from_bvh_frames(&parsed, &skeleton, 0..2)))
         }
@@ -95,8 +98,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             Format::Text => out.push_str(&text_report(&doc)),
         }
     }
-    io::write_output(args.common.output.as_deref(), out.as_bytes())
-        .with_context(|| format!("cannot write {}", args.common.output.as_ref().map_or("stdout".into(), |p| p.display().to_string())))
+    Ok(io::write_output(args.common.output.as_deref(), out.as_bytes())?)
 }
 
 /// AnyTop's record for one input: the rest pose is frame 0 of `--rest-pose` when given, else

@@ -118,11 +118,18 @@ pub fn read_dir_files(dir: &Path) -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
     Ok((info, bytes))
 }
 
+/// Diffusion steps a checkpoint may declare (ours train with 100).
+pub const MAX_SCHEDULE_STEPS: usize = 10_000;
+
 /// `checkpoint.json`'s description, checked to be ours and of this version.
 fn parse_info(info_json: &[u8]) -> anyhow::Result<CheckpointInfo> {
     let info: CheckpointInfo = serde_json::from_slice(info_json).context("checkpoint.json: not a checkpoint description")?;
     if info.format != FORMAT || info.version != VERSION {
         bail!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version);
+    }
+    // The noise schedule is rebuilt from this count; 0 or 1 steps is no schedule at all.
+    if !(2..=MAX_SCHEDULE_STEPS).contains(&info.schedule_steps) {
+        bail!("checkpoint.json: schedule_steps is {}, expected 2 to {MAX_SCHEDULE_STEPS}", info.schedule_steps);
     }
     Ok(info)
 }

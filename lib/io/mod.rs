@@ -1,9 +1,11 @@
 //! Where bytes come from and go to: `-` is stdin/stdout everywhere, and files are written
 //! atomically (temp file in the same directory, then rename) so a crash or an error never
-//! leaves half a file behind.
+//! leaves half a file behind (`output` says how, and what happens to devices and symlinks).
 
 pub mod npy;
-use std::io::{self, Read, Write};
+pub mod output;
+pub use output::{refuse_terminal, write_all, OutputError};
+use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
 /// Read a whole input; `-` reads stdin.
@@ -22,40 +24,9 @@ pub fn display_name(path: &Path) -> String {
     if path.as_os_str() == "-" { "<stdin>".to_string() } else { path.display().to_string() }
 }
 
-/// Write `bytes` to `path` atomically, or to stdout when `path` is `-` or `None`.
-pub fn write_output(path: Option<&Path>, bytes: &[u8]) -> io::Result<()> {
-    match path {
-        None => write_stdout(bytes),
-        Some(p) if p.as_os_str() == "-" => write_stdout(bytes),
-        Some(p) => write_atomic(p, bytes),
-    }
-}
-
-fn write_stdout(bytes: &[u8]) -> io::Result<()> {
-    let mut out = io::stdout().lock();
-    out.write_all(bytes)?;
-    out.flush()
-}
-
-/// Temp file beside the target, then rename: readers never see a partial file, and a failed
-/// write removes the temp file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let file_name = path.file_name().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "output path has no file name"))?;
-    let tmp = dir.join(format!(".{}.tmp{}", file_name.to_string_lossy(), std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+/// Write `bytes` to `path` (see `output`), or to stdout when `path` is `-` or `None`.
+pub fn write_output(path: Option<&Path>, bytes: &[u8]) -> Result<(), OutputError> {
+    output::write_one(path, bytes)
 }
 
 /// Output path for item `i` of a batch: `{i}` in the pattern is replaced by the index.

@@ -249,6 +249,12 @@ pub fn read(r: &mut impl Read, file: &str) -> Result<NpyArray, NpyError> {
 }
 
 /// Read one NPY array from bytes in memory.
+/// Whether an input is meant as NPY: its magic bytes, or a `.npy` name (so that a damaged NPY
+/// is reported as one, not as a BVH missing `HIERARCHY`).
+pub fn looks_like_npy(path: &std::path::Path, bytes: &[u8]) -> bool {
+    bytes.starts_with(b"\x93NUMPY") || path.extension().is_some_and(|x| x.eq_ignore_ascii_case("npy"))
+}
+
 pub fn from_bytes(bytes: &[u8], file: &str) -> Result<NpyArray, NpyError> {
     read(&mut &bytes[..], file)
 }

@@ -41,6 +41,13 @@ impl WorldPose {
 }
 
 impl Motion {
+    /// The first (frame, joint) whose rotation or translation holds a NaN or an infinity.
+    pub fn first_non_finite(&self) -> Option<(usize, usize)> {
+        let bad = |k: usize| !(self.rotations[k].is_finite() && self.translations[k].is_finite());
+        let k = (0..self.rotations.len().min(self.translations.len())).find(|&k| bad(k))?;
+        Some((k / self.joints.max(1), k % self.joints.max(1)))
+    }
+
     /// Build the motion of a parsed BVH (`skeleton` must come from the same file).
     pub fn from_bvh(bvh: &Bvh, skeleton: &Skeleton) -> Motion {
         Motion::from_bvh_frames(bvh, skeleton, 0..bvh.frames)

@@ -66,7 +66,7 @@ pub enum RetargetError {
     NonFinite { what: String, frame: usize, joint: usize },
     #[error("setting {what} = {value}: expected {expected}")]
     Setting { what: String, value: String, expected: String },
-    #[error("decoding the result: {0}")]
+    #[error("decoding the result")]
     Decode(#[from] m2m::M2mError),
 }
 

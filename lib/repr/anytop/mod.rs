@@ -291,7 +291,7 @@ pub enum AnyTopError {
     NonFinite { frame: usize, joint: usize, dim: usize },
     #[error("no frames to compute statistics from")]
     NoFrames,
-    #[error("{0}")]
+    #[error(transparent)]
     Skeleton(#[from] crate::skeleton::SkeletonError),
 }
 
