@@ -12,7 +12,7 @@ pub const MAX_THREADS: usize = 256;
 /// an hour at 30 fps.
 pub const MAX_FRAMES: usize = 108_000;
 /// `skel-aug --add`: joints inserted (a skeleton rarely has more than a few hundred).
-pub const MAX_ADD_JOINTS: usize = 1_000;
+pub const MAX_ADD_JOINTS: usize = 256;
 /// Variants or samples written by one run (`skel-aug -n`).
 pub const MAX_VARIANTS: u64 = 1_000;
 /// `mo-retarget --steps`: match-and-blend iterations per level (the paper uses 3).
