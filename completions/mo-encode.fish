@@ -13,7 +13,7 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-encode -l model -d 'The latent model: a directory from \'mo-train --arch sata\' [default: the built-in one]' -r -F
 complete -c mo-encode -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-encode -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-encode -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-encode -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-encode -l decode -d 'Decode an NPY of features back to BVH on --skeleton'
 complete -c mo-encode -l require-contacts -d 'anytop: fail when the skeleton has no foot joints, instead of writing all-zero contact features with a warning (for training data of walkers, where a missed foot is a bug)'
 complete -c mo-encode -l normalise -d 'anytop: write normalised features, (x - mean) / (std + 1e-6)'

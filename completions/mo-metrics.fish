@@ -31,7 +31,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l from -d 'AnyTop f
 positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -54,7 +54,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l fro
 positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -71,7 +71,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l from 
 positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -85,7 +85,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l
 positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -96,7 +96,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l from
 positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -110,7 +110,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l from -
 positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s h -l help -d 'Print help (see more with \'--help\')'

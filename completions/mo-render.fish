@@ -18,7 +18,7 @@ complete -c mo-render -l frame-labels -d 'JSON file of per-frame labels (tints f
 complete -c mo-render -l speed -d 'HTML: initial playback speed' -r
 complete -c mo-render -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-render -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-render -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-render -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-render -l fixed-camera -d 'One camera for the whole clip (shows travel) instead of following the body'
 complete -c mo-render -l overlay -d 'HTML: draw all motions in one scene instead of side by side'
 complete -c mo-render -s q -l quiet -d 'Print nothing on stderr but errors'

@@ -24,7 +24,7 @@ complete -c mo-retarget -l root-motion -d 'Where the root trajectory comes from'
 source\t'The source\'s trajectory, scaled to the target\'s size'"
 complete -c mo-retarget -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-retarget -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-retarget -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-retarget -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-retarget -l emit-binding -d 'Print the binding (JSON) and stop'
 complete -c mo-retarget -l copy-bound -d 'After synthesis, overwrite the bound channels with the source\'s (the paper\'s "directly copy", the reference\'s copy mode): bound joints follow the source exactly'
 complete -c mo-retarget -l report -d 'Print timing, binding, pyramid levels and per-level match cost on stderr'

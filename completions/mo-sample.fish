@@ -14,7 +14,7 @@ complete -c mo-sample -l smooth -d 'Low-pass the generated frames over time: the
 complete -c mo-sample -l blend -d 'Editing with --smooth: generated frames next to kept ones give way to them over this many seconds, continuing the kept motion instead of jumping to the generated one' -r
 complete -c mo-sample -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-sample -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-sample -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-sample -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-sample -l report -d 'Print seam continuity as one JSON line on stderr (with --reference)'
 complete -c mo-sample -l no-plant-feet -d 'Keep the model\'s root travel even where it makes planted feet slide (by default the root\'s horizontal motion follows the feet the model puts on the ground)'
 complete -c mo-sample -s q -l quiet -d 'Print nothing on stderr but errors'

@@ -12,7 +12,7 @@ complete -c mo-segment -l restarts -d 'K-means restarts from different seedings;
 complete -c mo-segment -l skeleton -d 'The input\'s skeleton, a skeleton document (skel-info) or a BVH file: a BVH input is encoded with its AnyTop record (as \'mo-encode --skeleton\' does), an NPY input is checked against it' -r -F
 complete -c mo-segment -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-segment -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-segment -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-segment -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-segment -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-segment -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-segment -s h -l help -d 'Print help (see more with \'--help\')'

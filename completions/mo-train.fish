@@ -16,7 +16,7 @@ complete -c mo-train -l augment-variants -d 'Augmented variants prepared per ske
 complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this often' -r
 complete -c mo-train -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-train -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
-complete -c mo-train -l threads -d 'Worker threads (default: all cores). Output never depends on this' -r
+complete -c mo-train -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
 complete -c mo-train -l resume -d 'Continue from the checkpoint in --out'
 complete -c mo-train -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-train -s v -l verbose -d 'Print more about what is happening on stderr'

@@ -297,6 +297,22 @@ mod tests {
     }
 
     #[test]
+    fn temp_files_are_registered_until_renamed() {
+        let dir = scratch("registry");
+        let target = dir.join("t.txt");
+        let (tmp, _f) = create_temp(&target).unwrap();
+        assert!(temps().contains(&tmp), "a live temp file is in the registry");
+        // What a signal handler does with the registry (on a copy: other tests run beside).
+        let mut copy = vec![tmp.clone()];
+        remove_locked(&mut copy);
+        assert!(!tmp.exists() && copy.is_empty());
+        let (tmp, _f) = create_temp(&target).unwrap();
+        commit_temp(&tmp, &target).unwrap();
+        assert!(!temps().contains(&tmp) && target.exists());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn a_directory_is_refused() {
         let dir = scratch("dir");
         assert!(matches!(write_one(Some(&dir), b"x"), Err(OutputError::Directory { .. })));
