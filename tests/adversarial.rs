@@ -219,6 +219,7 @@ fn invalid_inputs_are_refused() {
     let encoded = dir.join("biped.npy");
     assert!(run("mo-encode", &[b, "-o", s(&encoded)], None).status.success());
     let placement = write("placement.json", b"[{\"heading\": 1e308, \"root_xz\": [1.7e308, -1.7e308]}]");
+    let placement_syntax = write("placement-syntax.json", b"[\n  {\"heading\": 0,, }\n]\n");
     let bvh_out = dir.join("decoded.bvh");
 
     // A model whose schedule has no steps.
@@ -259,6 +260,14 @@ fn invalid_inputs_are_refused() {
         case("empty --rest-pose", "skel-info", &[s(&good), "--rest-pose", s(&empty), "-o", o], &["empty.bvh", "no frames"]).absent(&[&out]),
         // Messages.
         case("parent 999 said once", "mo-sample", &[s(&bad_parent), "-o", o], &["parent.json", "parent 999"]).absent(&[&out]),
+        case("-n 256 x 10000 frames", "mo-sample", &[b, "-n", "256", "--frames", "10000", "-o", o], &["budget"]).absent(&[&out]),
+        case(
+            "placement JSON syntax: line and column",
+            "mo-encode",
+            &[s(&encoded), "--decode", "--skeleton", b, "--placement", s(&placement_syntax), "-o", s(&bvh_out)],
+            &["placement-syntax.json", "line 2", "column"],
+        )
+        .absent(&[&bvh_out]),
         case("JSON syntax: line and column", "mo-encode", &[s(&encoded), "--decode", "--skeleton", s(&syntax), "-o", s(&bvh_out)], &["syntax.json", "line 3", "column"])
             .absent(&[&bvh_out]),
     ];

@@ -190,6 +190,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             (None, None) => 120,
         },
     };
+    // Every sample goes through the denoiser at once: a few activations of its width per
+    // joint and frame.
+    let tokens = count as u128 * frames as u128 * skeleton.len() as u128;
+    crate::budget::check(&format!("{count} samples of {frames} frames on {} joints", skeleton.len()), tokens, loaded.info.config.width * 4 * 4)?;
     let mask = match &reference {
         Some(r) => Some(keep_mask(args, r, skeleton, frames)?),
         None => None,
