@@ -104,7 +104,7 @@ pub enum Align {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     let pairwise = args.joints || args.frames;
     let inputs = expand_inputs(&args.inputs)?;
     match (pairwise, inputs.len()) {

@@ -224,7 +224,7 @@ impl Repr {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     if args.latent || args.decode_latent {
         return latent(args);
     }

@@ -218,7 +218,7 @@ impl GroundArg {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     let started = std::time::Instant::now();
     let report = match &args.command {
         Command::Physics { inputs, ground, contact_height, contact_speed } => {

@@ -234,7 +234,7 @@ fn read_text(path: &Path) -> anyhow::Result<String> {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     if !(args.speed.is_finite() && args.speed > 0.0 && args.speed <= 100.0) {
         bail!("--speed must be within (0, 100], found {}", args.speed);
     }

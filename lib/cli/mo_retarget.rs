@@ -316,7 +316,7 @@ fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Setti
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     if args.method == Method::Latent {
         return run_latent(args);
     }

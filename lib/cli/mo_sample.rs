@@ -153,7 +153,7 @@ pub enum SamplerArg {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     crate::nn::keep_freed_memory();
     let count = args.samples as usize;
     let outputs: Option<Vec<PathBuf>> = match &args.bvh {

@@ -221,7 +221,7 @@ pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOpti
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     if !(args.window.is_finite() && args.window >= 0.0 && args.window <= bounds::MAX_SECONDS) {
         bail!("--window must be a number of seconds >= 0, found {}", args.window);
     }

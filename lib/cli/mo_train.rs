@@ -235,7 +235,7 @@ fn bar(done: u64, total: u64, width: usize) -> String {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     crate::nn::keep_freed_memory();
     if !(args.lr.is_finite() && args.lr > 0.0) {
         bail!("--lr must be a positive number, found {}", args.lr);

@@ -45,12 +45,14 @@ pub struct CommonOpts {
 }
 
 impl CommonOpts {
-    /// Apply `--threads` to rayon's global pool (once per process; a second call, as in tests
-    /// that run tools in one process, keeps the pool there is).
-    pub fn init_threads(&self) {
-        if let Some(n) = self.threads {
-            let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
-        }
+    /// Apply `--threads` to rayon's global pool, once per process (later calls, as in tests
+    /// that run tools in one process, return the first one's result). A pool that cannot be
+    /// built is an error: rayon would panic at its first use afterwards.
+    pub fn init_threads(&self) -> anyhow::Result<()> {
+        static BUILT: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+        let Some(n) = self.threads else { return Ok(()) };
+        let built = BUILT.get_or_init(|| rayon::ThreadPoolBuilder::new().num_threads(n).build_global().map_err(|e| e.to_string()));
+        built.clone().map_err(|e| anyhow::anyhow!("cannot start {n} worker threads: {e}"))
     }
 }
 

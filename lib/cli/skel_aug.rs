@@ -87,7 +87,7 @@ enum Input {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     let options = options(args)?;
     let count = usize::try_from(args.variants).context("too many variants")?;
     // Output paths first: a bad pattern fails before any work and before any output.

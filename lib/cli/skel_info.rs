@@ -62,7 +62,7 @@ pub enum Format {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    args.common.init_threads();
+    args.common.init_threads()?;
     if args.inputs.iter().filter(|p| p.as_os_str() == "-").count() > 1 {
         anyhow::bail!("stdin ('-') can be read only once");
     }
