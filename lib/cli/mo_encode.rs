@@ -620,7 +620,7 @@ fn read_placements(path: &Path, samples: usize, npy_name: &str) -> anyhow::Resul
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read placements {name}"))?;
     // JSON first, so a syntax error keeps its line and column (an untagged enum's error has none).
-    let value: serde_json::Value = serde_json::from_slice(&bytes).map_err(|e| anyhow!("{name}: not JSON: {e}"))?;
+    let value: serde_json::Value = serde_json::from_slice(&bytes).map_err(|e| anyhow!("{name}: not a placement file (not JSON): {e}"))?;
     let placements = match serde_json::from_value::<PlacementFile>(value) {
         Ok(PlacementFile::List(list)) => list,
         Ok(PlacementFile::One(one)) => vec![one],
