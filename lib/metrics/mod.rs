@@ -11,6 +11,7 @@ pub mod generation;
 pub mod geometric;
 pub mod kinetic;
 pub mod linalg;
+pub mod movement;
 pub mod physics;
 pub mod reconstruction;
 pub mod transfer;
