@@ -372,7 +372,7 @@ mod tests {
         let j = skeleton.len();
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 3, &Device::Cpu), &DenoiserConfig::tiny()).unwrap();
-        let mut rng = crate::synth::SplitMix64::new(11);
+        let mut rng = crate::rng::SplitMix64::new(11);
         let frames = 10;
         let data: Vec<f32> = (0..frames * j * 13).map(|_| rng.range(-3.0, 3.0) as f32).collect();
         let stats = AnyTopStats { mean: (0..j * 13).map(|k| (k % 7) as f32 * 0.1).collect(), std: vec![2.0; j * 13] };

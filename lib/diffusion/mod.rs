@@ -8,5 +8,6 @@ pub mod edit;
 pub mod sample;
 pub mod schedule;
 pub mod train;
+pub mod trainer;
 
 pub use schedule::{Sampler, Schedule, Step};

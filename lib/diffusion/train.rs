@@ -10,7 +10,7 @@
 use super::data::{Crop, TrainSet};
 use super::schedule::Schedule;
 use crate::nn::{batch_from, BatchItem, Denoiser};
-use crate::synth::SplitMix64;
+use crate::rng::{gaussian, SplitMix64};
 use candle_core::cpu_backend::unary_map;
 use candle_core::{CpuStorage, CustomOp1, DType, Device, Layout, Shape, Tensor, Var};
 use candle_nn::VarMap;
@@ -89,21 +89,6 @@ impl AdamW {
 pub fn named_vars(varmap: &VarMap) -> BTreeMap<String, Var> {
     let data = varmap.data().lock().expect("the VarMap lock is never poisoned: nothing panics while holding it");
     data.iter().map(|(k, v)| (k.clone(), v.clone())).collect()
-}
-
-/// Standard normal values from `rng` (Box–Muller), as f32.
-pub fn gaussian(rng: &mut SplitMix64, n: usize) -> Vec<f32> {
-    let mut out = Vec::with_capacity(n + 1);
-    while out.len() < n {
-        let u1 = rng.unit().max(f64::MIN_POSITIVE);
-        let u2 = rng.unit();
-        let r = (-2.0 * u1.ln()).sqrt();
-        let a = std::f64::consts::TAU * u2;
-        out.push((r * a.cos()) as f32);
-        out.push((r * a.sin()) as f32);
-    }
-    out.truncate(n);
-    out
 }
 
 /// What one training step measured.
@@ -228,7 +213,7 @@ fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Cro
     Ok(LossSums { squared, values, rotation: Some(rotation), tokens })
 }
 
-/// One training step: `training_loss`, backward, AdamW.
+/// One training step: `training_loss`, backward, AdamW; no update when the loss is not finite.
 #[allow(clippy::too_many_arguments)]
 pub fn train_step(
     model: &Denoiser,
@@ -243,9 +228,14 @@ pub fn train_step(
     device: &Device,
 ) -> anyhow::Result<StepStats> {
     let loss = training_loss(model, set, schedule, rng, batch, crop, lambda_geo, device)?;
+    let value = loss.to_scalar::<f32>()? as f64;
+    if !value.is_finite() {
+        // No update from a NaN gradient: the caller stops with the model as it was.
+        return Ok(StepStats { loss: value });
+    }
     let grads = loss.backward()?;
     opt.update(vars, &grads)?;
-    Ok(StepStats { loss: loss.to_scalar::<f32>()? as f64 })
+    Ok(StepStats { loss: value })
 }
 
 /// The cosine argument is clamped to [−1 + ε, 1 − ε] before arccos, as the reference does, so

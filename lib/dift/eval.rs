@@ -11,7 +11,7 @@ use super::correspond::Match;
 use crate::embed::NameTable;
 use crate::motion::Motion;
 use crate::skeleton::{names, Joint, Skeleton};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use glam::DVec3;
 
 /// `skeleton` and `motion` with the joints in another valid file order — every joint's children

@@ -16,7 +16,7 @@ pub mod eval;
 use crate::diffusion::checkpoint::CheckpointInfo;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::sample::Condition;
-use crate::diffusion::train::gaussian;
+use crate::rng::gaussian;
 use crate::diffusion::Schedule;
 use crate::document::AnyTopSection;
 use crate::motion::Motion;
@@ -24,7 +24,7 @@ use crate::nn::{batch_from, BatchItem, Denoiser};
 use crate::repr::anytop::AnyTopStats;
 use crate::repr::Features;
 use crate::skeleton::Skeleton;
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use anyhow::{bail, Context};
 use candle_core::Device;
 

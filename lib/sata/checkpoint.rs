@@ -91,3 +91,11 @@ pub fn frozen(dir: &Path, device: &Device) -> anyhow::Result<Frozen> {
     model.rigs = KnownRigs::read(dir)?;
     Ok(model)
 }
+
+/// The latent model that ships inside the binaries (models/zoo-sata, see its MODEL_CARD.md).
+pub fn frozen_default(device: &Device) -> anyhow::Result<Frozen> {
+    const INFO: &[u8] = include_bytes!("../../models/zoo-sata/checkpoint.json");
+    const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-sata/model.safetensors");
+    const RIGS: &[u8] = include_bytes!("../../models/zoo-sata/rigs.json");
+    frozen_bytes(INFO, WEIGHTS, Some(RIGS), device).context("the built-in latent model")
+}

@@ -30,6 +30,7 @@ pub mod infer;
 pub mod model;
 pub mod rigs;
 pub mod train;
+pub mod trainer;
 
 pub use graph::SkeletonGraph;
 pub use model::SataModel;

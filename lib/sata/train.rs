@@ -12,9 +12,10 @@
 use super::graph::{rest_row, SkeletonGraph};
 use super::{SataModel, FEATURE_DIMS};
 use crate::diffusion::data::{Crop, TrainSet};
-use crate::diffusion::train::{gaussian, rotation_distance, AdamW};
+use crate::diffusion::train::{rotation_distance, AdamW};
+use crate::rng::gaussian;
 use crate::repr::Features;
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use candle_core::{Device, Tensor, Var};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -266,7 +267,7 @@ pub fn cycle_loss(model: &SataModel, mu: &Tensor, other: &SkeletonGraph, scale: 
 /// the term costs about half a step, not a whole one.
 const CYCLE_CROPS: usize = 4;
 
-/// One training step: draw, loss, backward, AdamW.
+/// One training step: draw, loss, backward, AdamW; no update when the loss is not finite.
 #[allow(clippy::too_many_arguments)]
 pub fn train_step(
     model: &SataModel,
@@ -302,7 +303,8 @@ pub fn train_step(
         }
     }
     if !report.total.is_finite() {
-        anyhow::bail!("the loss is not finite ({report:?}) at skeleton {}", sk.name);
+        // No update from a NaN gradient: the caller stops with the model as it was.
+        return Ok(report);
     }
     let grads = total.backward()?;
     opt.update(vars, &grads)?;
