@@ -17,10 +17,10 @@ use std::path::Path;
 
 /// `--model DIR`, or the built-in latent model.
 pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<Frozen> {
-    match dir {
-        Some(dir) => checkpoint::frozen(dir, device),
-        None => checkpoint::frozen_default(device),
-    }
+    Ok(match dir {
+        Some(dir) => checkpoint::frozen(dir, device)?,
+        None => checkpoint::frozen_default(device)?,
+    })
 }
 
 /// The rig to read or write `skeleton`'s motion with, and the skeleton it fits: the model's

@@ -3,6 +3,7 @@
 //! (`schedule::Step`). The rest-pose token stays the skeleton's P_S throughout.
 
 use super::schedule::{Sampler, Schedule};
+use super::DiffusionError;
 use crate::rng::gaussian;
 use crate::nn::{batch_from, BatchItem, Denoiser};
 use crate::repr::anytop::{plant_feet, AnyTopStats};
@@ -32,10 +33,10 @@ pub struct SampleOptions {
 }
 
 /// `samples` motions, denormalised AnyTop features `[frames, joints, 13]` each.
-pub fn sample(model: &Denoiser, schedule: &Schedule, cond: &Condition, opts: &SampleOptions, device: &Device) -> anyhow::Result<Vec<Features>> {
+pub fn sample(model: &Denoiser, schedule: &Schedule, cond: &Condition, opts: &SampleOptions, device: &Device) -> Result<Vec<Features>, DiffusionError> {
     let mut x = denoise(model, schedule, cond, opts, None, device)?;
     for f in &mut x {
-        cond.stats.denormalise(f).map_err(|e| anyhow::anyhow!("denormalising the samples: {e}"))?;
+        cond.stats.denormalise(f).map_err(|source| DiffusionError::Stats { what: "denormalising the samples", source })?;
     }
     Ok(x)
 }
@@ -62,18 +63,19 @@ pub(super) fn denoise(
     opts: &SampleOptions,
     imposed: Option<&Imposed>,
     device: &Device,
-) -> anyhow::Result<Vec<Features>> {
+) -> Result<Vec<Features>, DiffusionError> {
     let joints = cond.names.len();
     let dims = model.config().feature_dims;
     let per = opts.frames * joints * dims;
     if let Some(k) = imposed {
-        anyhow::ensure!(
-            k.reference.len() == per && k.known.len() == per,
-            "the known motion has {} values and {} flags; sampling {} frames x {joints} joints x {dims} needs {per}",
-            k.reference.len(),
-            k.known.len(),
-            opts.frames
-        );
+        if k.reference.len() != per || k.known.len() != per {
+            return Err(DiffusionError::Invalid(format!(
+                "the known motion has {} values and {} flags; sampling {} frames x {joints} joints x {dims} needs {per}",
+                k.reference.len(),
+                k.known.len(),
+                opts.frames
+            )));
+        }
     }
     let mut rng = SplitMix64::new(opts.seed);
     let mut known_rng = imposed.map(|k| SplitMix64::new(k.seed));

@@ -9,7 +9,7 @@
 
 use super::data::{Crop, TrainSet};
 use super::schedule::Schedule;
-use crate::nn::{batch_from, BatchItem, Denoiser};
+use crate::nn::{batch_from, BatchItem, Denoiser, NnError};
 use crate::rng::{gaussian, SplitMix64};
 use candle_core::cpu_backend::unary_map;
 use candle_core::{CpuStorage, CustomOp1, DType, Device, Layout, Shape, Tensor, Var};
@@ -116,7 +116,7 @@ pub fn training_loss(
     crop: usize,
     lambda_geo: f64,
     device: &Device,
-) -> anyhow::Result<Tensor> {
+) -> Result<Tensor, NnError> {
     let crops = set.sample(rng, batch, crop);
     let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
     let mut order: Vec<(usize, Option<usize>)> = Vec::new();
@@ -144,7 +144,7 @@ pub fn training_loss(
             },
         });
     }
-    let Some(sums) = total else { anyhow::bail!("an empty training batch") };
+    let Some(sums) = total else { return Err(NnError::Shape { what: "training batch", expected: "at least one crop".into(), got: vec![0] }) };
     let mse = (sums.squared / sums.values.max(1.0))?;
     match sums.rotation {
         Some(rotation) if lambda_geo != 0.0 => Ok((&mse + ((rotation / sums.tokens.max(1.0))? * lambda_geo)?)?),
@@ -162,7 +162,7 @@ struct LossSums {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, rotation: bool, device: &Device) -> anyhow::Result<LossSums> {
+fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, rotation: bool, device: &Device) -> Result<LossSums, NnError> {
     let features: Vec<_> = crops.iter().map(|c| set.crop(c)).collect();
     let items: Vec<BatchItem> = crops
         .iter()
@@ -226,7 +226,7 @@ pub fn train_step(
     crop: usize,
     lambda_geo: f64,
     device: &Device,
-) -> anyhow::Result<StepStats> {
+) -> Result<StepStats, NnError> {
     let loss = training_loss(model, set, schedule, rng, batch, crop, lambda_geo, device)?;
     let value = loss.to_scalar::<f32>()? as f64;
     if !value.is_finite() {

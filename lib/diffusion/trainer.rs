@@ -41,12 +41,12 @@ pub enum TrainError {
     #[error("the loss of step {step} is not finite ({losses}): training stopped, {}", match kept { Some(s) => format!("the checkpoint of step {s} is kept"), None => "no checkpoint was saved".to_string() })]
     NonFinite { step: u64, losses: String, kept: Option<u64> },
     #[error(transparent)]
-    Config(#[from] NnError),
+    Checkpoint(#[from] checkpoint::CheckpointError),
     #[error(transparent)]
-    Tensor(#[from] candle_core::Error),
-    /// From the model's step or checkpoint code.
+    Nn(#[from] NnError),
+    /// From another model's training step (`sata::SataError`).
     #[error(transparent)]
-    Model(#[from] anyhow::Error),
+    Model(Box<dyn std::error::Error + Send + Sync>),
 }
 
 /// The data stream of step k depends only on the seed and k, so a resumed run draws what the

@@ -112,7 +112,7 @@ pub fn score_joints(matches: &[Match], truth: &[Option<usize>], mirror: &[Option
 }
 
 /// Names-only baseline descriptors: the joint names' text embeddings.
-pub fn name_descriptors(skeleton: &Skeleton) -> anyhow::Result<Vec<Vec<f32>>> {
+pub fn name_descriptors(skeleton: &Skeleton) -> Result<Vec<Vec<f32>>, crate::embed::EmbedError> {
     Ok(NameTable::builtin()?.embed_skeleton(skeleton))
 }
 
