@@ -85,7 +85,7 @@ impl PolarGaussian {
         PolarGaussian { rng: SplitMix64::new(seed ^ 0x6d6f_2d72_6574_6172), spare: None }
     }
 
-    pub fn next(&mut self) -> f32 {
+    pub fn draw(&mut self) -> f32 {
         if let Some(s) = self.spare.take() {
             return s;
         }
@@ -116,13 +116,13 @@ mod tests {
     #[test]
     fn polar_standard_normal_moments_and_determinism() {
         let mut g = PolarGaussian::new(3);
-        let xs: Vec<f64> = (0..20_000).map(|_| g.next() as f64).collect();
+        let xs: Vec<f64> = (0..20_000).map(|_| g.draw() as f64).collect();
         let (mean, var) = moments(&xs);
         assert!(mean.abs() < 0.03 && (var - 1.0).abs() < 0.05, "{mean} {var}");
         assert!(xs.iter().all(|x| x.is_finite()));
         let mut again = PolarGaussian::new(3);
-        assert_eq!(again.next() as f64, xs[0]);
-        assert_ne!(PolarGaussian::new(4).next() as f64, xs[0]);
+        assert_eq!(again.draw() as f64, xs[0]);
+        assert_ne!(PolarGaussian::new(4).draw() as f64, xs[0]);
     }
 
     #[test]
@@ -138,7 +138,7 @@ mod tests {
     #[test]
     fn the_two_normal_generators_differ() {
         let mut polar = PolarGaussian::new(0);
-        let polar: Vec<f32> = (0..4).map(|_| polar.next()).collect();
+        let polar: Vec<f32> = (0..4).map(|_| polar.draw()).collect();
         assert_ne!(polar, gaussian(&mut SplitMix64::new(0x6d6f_2d72_6574_6172), 4), "from the same generator state");
     }
 }

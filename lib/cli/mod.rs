@@ -3,8 +3,8 @@
 //! definitions that parse the arguments).
 //!
 //! Exit codes: 0 ok; 2 usage, I/O or data error; 130 for an interrupted `mo-train` ([`Exit`];
-//! 1, a valid negative answer, arrives with the first tool that has one, e.g. a metrics check). Errors print
-//! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
+//! 1, a valid negative answer, arrives with the first tool that has one, e.g. a metrics check).
+//! Errors print as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
 pub mod docs;
 pub mod latent;

@@ -406,7 +406,7 @@ impl<'a> Plan<'a> {
             c.data.par_chunks_mut(c.width).enumerate().for_each(|(t, row)| {
                 let mut gauss = PolarGaussian::new(stream_seed(seed, stream, t as u64));
                 for &k in &free {
-                    let x = row[k] + sigma * gauss.next();
+                    let x = row[k] + sigma * gauss.draw();
                     // fmod(x, 1) as the reference. The integer cast truncates like fmod without
                     // a library call; |x| is far below i64's range (sigma is at most 1e6).
                     row[k] = x - (x as i64) as f32;

@@ -74,7 +74,7 @@ impl Frozen {
             return Err(SataError::Invalid(format!("features are [{}, {}, {}], the skeleton needs [frames, {}, {FEATURE_DIMS}]", features.frames, features.joints, features.dims, g.joints)));
         }
         if features.frames == 0 {
-            return Err(SataError::Invalid(format!("no frames to encode")));
+            return Err(SataError::Invalid("no frames to encode".into()));
         }
         let mut scaled = features.clone();
         self.info.scale.apply(&mut scaled, &g.rest);
