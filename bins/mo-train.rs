@@ -1,8 +1,7 @@
 use clap::Parser;
-use menagerie::cli::mo_train;
+use menagerie::cli::{finish, mo_train};
 
 fn main() -> std::process::ExitCode {
     let args = mo_train::Args::parse();
-    // Not `cli::finish`: an interrupted run exits 130, not 2.
-    mo_train::main(&args)
+    finish("mo-train", mo_train::run(&args))
 }

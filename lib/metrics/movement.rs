@@ -27,7 +27,7 @@
 use super::generation::PointClip;
 use super::physics::{contacts, PhysicsOptions};
 use super::{Clip, MetricError};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use glam::DVec3;
 use rayon::prelude::*;
 
