@@ -27,7 +27,7 @@ use menagerie::document::AnyTopSection;
 use menagerie::motion::Motion;
 use menagerie::repr::anytop::AnyTopOptions;
 use menagerie::skeleton::Skeleton;
-use menagerie::synth::SplitMix64;
+use menagerie::rng::SplitMix64;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

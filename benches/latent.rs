@@ -29,7 +29,7 @@ use menagerie::repr::Features;
 use menagerie::sata::checkpoint::{self, Frozen};
 use menagerie::sata::infer::{Latents, Prepared};
 use menagerie::skeleton::Skeleton;
-use menagerie::synth::SplitMix64;
+use menagerie::rng::SplitMix64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -93,7 +93,7 @@ fn models(device: &Device) -> Vec<(String, Frozen)> {
         .filter(|s| !s.is_empty())
         .map(|item| {
             let (name, dir) = item.split_once('=').unwrap_or(("model", item));
-            let model = if dir.is_empty() { menagerie::cli::latent::load_model(None, device) } else { checkpoint::frozen(Path::new(dir), device) };
+            let model = if dir.is_empty() { checkpoint::frozen_default(device) } else { checkpoint::frozen(Path::new(dir), device) };
             (name.to_string(), model.unwrap_or_else(|e| panic!("{item}: {e:#}")))
         })
         .collect()

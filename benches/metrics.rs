@@ -21,7 +21,8 @@ use menagerie::metrics::Clip;
 use menagerie::motion::Motion;
 use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig};
 use menagerie::skeleton::{roles, Skeleton};
-use menagerie::synth::{creature, SplitMix64};
+use menagerie::rng::SplitMix64;
+use menagerie::synth::creature;
 use std::hint::black_box;
 use std::path::Path;
 

@@ -24,7 +24,7 @@ use glam::DVec3;
 use menagerie::nn::{batch_from, seeded_var_builder, BatchItem, Denoiser, DenoiserConfig};
 use menagerie::repr::Features;
 use menagerie::skeleton::{topology, Joint, Skeleton};
-use menagerie::synth::SplitMix64;
+use menagerie::rng::SplitMix64;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 

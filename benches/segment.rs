@@ -30,7 +30,8 @@ use menagerie::motion::Motion;
 use menagerie::segment::{boundaries, boundary_errors, SegmentOptions};
 use menagerie::skeleton::Skeleton;
 use menagerie::synth::{actions, training_clip, Action};
-use menagerie::synth::{creature_names, SplitMix64};
+use menagerie::rng::SplitMix64;
+use menagerie::synth::creature_names;
 use std::path::Path;
 use std::time::{Duration, Instant};
 

@@ -5,6 +5,6 @@ fn main() -> std::process::ExitCode {
         Ok(a) => a,
         Err(code) => return code,
     };
-    // Not `cli::main`: mo-train owns Ctrl-C (it checkpoints) and an interrupted run exits 130.
-    mo_train::main(&args)
+    // Not `cli::main`: mo-train owns Ctrl-C (it checkpoints; an interrupted run exits 130).
+    cli::finish("mo-train", mo_train::run(&args))
 }

@@ -78,7 +78,7 @@ fn flamingo_legs_bind_to_monkey_legs_left_to_left() {
 #[test]
 fn skel_aug_variants_bind_back_to_their_original() {
     use menagerie::augment::{self, Options, RemoveAmount};
-    use menagerie::synth::SplitMix64;
+    use menagerie::rng::SplitMix64;
     let Some(data) = common::shared_data("skel_aug_variants_bind_back_to_their_original") else { return };
     let bvh = data.join("bvh");
     // (correct, returned) with default options, and with geometry only (names ignored).

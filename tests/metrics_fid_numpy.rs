@@ -6,7 +6,7 @@
 mod common;
 
 use menagerie::metrics::fid::{fid, FidOptions};
-use menagerie::synth::SplitMix64;
+use menagerie::rng::SplitMix64;
 use std::process::Command;
 
 const TEXTBOOK: &str = r#"

@@ -95,3 +95,31 @@ fn augmentation_flags_and_skeleton_names_are_recorded() {
         assert!(out.status.code() == Some(2) && stderr.contains("'--augment <P>'"), "{bad}: {stderr}");
     }
 }
+
+/// A learning rate that blows the model up: the first non-finite loss stops training with exit
+/// 2, the checkpoint stays the last good one, and every log line is JSON.
+#[test]
+fn a_non_finite_loss_stops_and_keeps_the_last_checkpoint() {
+    let dir = tempdir("train-nan");
+    let data = data(&dir);
+    for arch in ["anytop", "sata"] {
+        let out = dir.join(arch);
+        let mut args = train_args(&data, &out, "2");
+        args.extend(["--arch", arch, "-q"]);
+        ok(&run("mo-train", &args, None), arch);
+        let model = std::fs::read(out.join("model.safetensors")).unwrap();
+        let mut args = train_args(&data, &out, "20");
+        args.extend(["--arch", arch, "--resume", "--lr", "1e30"]);
+        let result = run("mo-train", &args, None);
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(2), "{arch}: {stderr}");
+        assert!(stderr.contains("is not finite") && stderr.contains("the checkpoint of step 2 is kept"), "{arch}: {stderr}");
+        assert_eq!(info(&out)["step"].as_u64(), Some(2), "{arch}");
+        assert_eq!(std::fs::read(out.join("model.safetensors")).unwrap(), model, "{arch}: the model of step 2 stays");
+        let log = std::fs::read_to_string(out.join("log.jsonl")).unwrap();
+        for line in log.lines() {
+            let value: serde_json::Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{arch}: {line}: {e}"));
+            assert!(value["loss"].as_f64().is_some_and(f64::is_finite), "{arch}: {line}");
+        }
+    }
+}

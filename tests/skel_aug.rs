@@ -22,7 +22,7 @@ use menagerie::bvh::{self, Bvh};
 use menagerie::document::SkeletonDocument;
 use menagerie::motion::Motion;
 use menagerie::skeleton::{roles, topology, Skeleton};
-use menagerie::synth::SplitMix64;
+use menagerie::rng::SplitMix64;
 use std::path::Path;
 
 /// World positions must agree within this fraction of the skeleton's size.

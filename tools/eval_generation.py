@@ -22,6 +22,11 @@ import tempfile
 import time
 
 METRICS = [
+    ("energy_ratio", "energy ratio"),
+    ("nearest_pose", "nearest pose"),
+    ("calibrated_coverage", "cal. coverage %"),
+    ("duty_factor", "duty"),
+    ("mixed_contact", "mixed contact"),
     ("coverage", "coverage %"),
     ("local_diversity", "local div"),
     ("inter_diversity", "inter div"),
@@ -51,8 +56,11 @@ def metrics(bindir, folder, generated, skeleton):
     cmd = [f"{bindir}/mo-metrics", "generation", "--gt", folder, "--gen", generated]
     if generated.endswith(".npy"):
         cmd += ["--skeleton", skeleton]
-    report = json.loads(run(cmd))["report"]
-    out = {k: report[k]["mean"] for k, _ in METRICS}
+    full = json.loads(run(cmd))
+    report = full["report"]
+    movement = full["movement"]
+    out = {k: movement["samples"][k] if k in movement["samples"] else report[k]["mean"] for k, _ in METRICS}
+    out["baselines"] = movement["baselines"]
     files = clips(generated) if os.path.isdir(generated) else []
     if files:
         phys = json.loads(run([f"{bindir}/mo-metrics", "physics"] + files))["files"]
@@ -72,7 +80,9 @@ def cells(m, ranges=False):
             lo, hi = m[k + "_range"]
             return f"{m[k]:.3f} ({lo:.3f}-{hi:.3f})"
         return f"{m[k]:.3f}"
-    return [f"{m[k]:.3f}" for k, _ in METRICS] + [phys(k) for k, _ in PHYSICS]
+    def num(v):
+        return "-" if v is None else f"{v:.3f}"
+    return [num(m.get(k)) for k, _ in METRICS] + [phys(k) for k, _ in PHYSICS]
 
 
 def sample(bindir, model, skeleton, out, n, frames, steps, sampler, seed):
@@ -117,10 +127,18 @@ def main():
         # The clips' physics with their per-clip range in brackets: "within the range of the
         # training data" is judged against it.
         print(row([name, "gt (the clips)"] + cells(m, ranges=True)), flush=True)
+        # The movement baselines (from the clips alone): leave-one-out clips, a static mean
+        # pose, random crops as many and as long as the samples.
+        base = None
         for label, model in models:
             out = os.path.join(tmp, f"{name}_{label}")
             sample(args.bin, model, skeleton, out, args.n, args.frames, args.steps, args.sampler, args.seed)
             m = metrics(args.bin, folder, out, skeleton)
+            if base is None:
+                base = m["baselines"]
+                for key, text in [("clips", "clips, leave-one-out"), ("mean_pose", "static mean pose"), ("random_crops", "random crops")]:
+                    b = dict(base[key])
+                    print(row([name, text] + [("-" if b.get(k) is None else f"{b[k]:.3f}") if k in b else "" for k, _ in METRICS] + [""] * len(PHYSICS)), flush=True)
             print(row([name, label] + cells(m)), flush=True)
     if args.steps_table and models:
         label, model = models[0]

@@ -24,7 +24,7 @@ pub use subdivide::{choose_splits, mid_name, splittable_bones, subdivide, Added}
 use crate::bvh::Bvh;
 use crate::motion::Motion;
 use crate::skeleton::{topology, Skeleton};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 
 /// What to do to a skeleton: remove first (counted against the original joints), then add.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -19,7 +19,7 @@ use super::edit::Edit;
 use super::below;
 use crate::motion::Motion;
 use crate::skeleton::{roles, Skeleton};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 
 /// How many joints to remove.
 #[derive(Clone, Copy, Debug, PartialEq)]

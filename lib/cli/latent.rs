@@ -15,17 +15,12 @@ use anyhow::{bail, Context};
 use candle_core::Device;
 use std::path::Path;
 
-/// `--model DIR`, or the built-in latent model (models/zoo-sata, see its MODEL_CARD.md).
+/// `--model DIR`, or the built-in latent model.
 pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<Frozen> {
-    match dir {
-        Some(dir) => checkpoint::frozen(dir, device),
-        None => {
-            const INFO: &[u8] = include_bytes!("../../models/zoo-sata/checkpoint.json");
-            const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-sata/model.safetensors");
-            const RIGS: &[u8] = include_bytes!("../../models/zoo-sata/rigs.json");
-            checkpoint::frozen_bytes(INFO, WEIGHTS, Some(RIGS), device).context("the built-in latent model")
-        }
-    }
+    Ok(match dir {
+        Some(dir) => checkpoint::frozen(dir, device)?,
+        None => checkpoint::frozen_default(device)?,
+    })
 }
 
 /// The rig to read or write `skeleton`'s motion with, and the skeleton it fits: the model's

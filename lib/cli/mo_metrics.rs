@@ -12,6 +12,7 @@ use crate::document::AnyTopSection;
 use crate::io;
 use crate::metrics::fid::{fid, FidOptions};
 use crate::metrics::generation::{self, GenerationOptions, PointClip};
+use crate::metrics::movement;
 use crate::metrics::physics::{Ground, PhysicsOptions};
 use crate::metrics::{geometric, kinetic, physics, reconstruction, transfer, Clip};
 use crate::repr::anytop::AnyTopOptions;
@@ -87,6 +88,13 @@ pub enum Command {
     /// per frame; inter diversity the distance between consecutive samples; intra diversity
     /// the distance between two random windows of a sample, and its difference from the ground
     /// truth's. Values are mean and std over samples.
+    ///
+    /// The `movement` block tells a statue from a walk, for the samples and for three
+    /// baselines made from the ground truth (its clips each left out in turn, their static mean
+    /// pose, random crops): motion energy (joint speed relative to the root, body sizes per
+    /// second) and its ratio to the clips', the distance of each pose to the nearest clip pose,
+    /// coverage with thresholds calibrated on the clips, and foot contact (duty factor, share
+    /// of frames with some feet down and some up). Definitions: docs/metrics.md.
     Generation {
         /// Ground-truth clips (files or directories).
         #[arg(long, value_name = "PATH", required = true, num_args = 1..)]
@@ -503,14 +511,24 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
     };
     let (gt_points, gen_points) = (points(&gt)?, points(&gen)?);
     let report = generation::generation_metrics(&gen_points, &gt_points, opts)?;
+    let movement = movement_report(&gt, &gen, &gt_points, &gen_points, opts.seed)?;
     Ok(json!({
         "metric": "generation",
         "skeleton": first.name,
         "gt_clips": gt.len(),
         "generated_samples": gen.len(),
         "report": report,
+        "movement": movement,
         "units": units(&[
             ("coverage", "percent of ground-truth windows"),
+            ("energy", "body sizes per second (joints relative to the root, 5-frame average)"),
+            ("energy_ratio", "energy / the clips' mean energy"),
+            ("energy_ratio_range", "lowest and highest ratio of one motion"),
+            ("nearest_pose", "pairwise joint distances / body size, mean absolute difference"),
+            ("calibrated_coverage", "percent of ground-truth windows within the calibrated threshold"),
+            ("threshold", "mean joint distance, AnyTop units (a quantile of the clips' own nearest-window distances)"),
+            ("duty_factor", "share of frames a foot is in contact"),
+            ("mixed_contact", "share of frames with some feet down and some up"),
             ("local_diversity", "mean joint distance, AnyTop units (mean SMPL bone = 0.209)"),
             ("global_diversity", "mean joint distance per frame, AnyTop units"),
             ("inter_diversity", "mean joint distance, AnyTop units"),
@@ -518,6 +536,28 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
             ("gt_intra_diversity", "mean joint distance, AnyTop units"),
             ("intra_diversity_diff", "mean joint distance, AnyTop units"),
         ]),
+    }))
+}
+
+/// The movement metrics (`metrics::movement`) of the samples and of baselines made from the
+/// clips: the clips left out one at a time, their static mean pose and random crops, as many
+/// and as long as the samples.
+fn movement_report(gt: &[Loaded], gen: &[Loaded], gt_points: &[PointClip], gen_points: &[PointClip], seed: u64) -> anyhow::Result<Value> {
+    let world = |ls: &[Loaded]| -> anyhow::Result<Vec<Clip>> { ls.iter().map(clip_of).collect() };
+    let (gt_world, gen_world) = (world(gt)?, world(gen)?);
+    let reference = movement::Reference::new(&gt_world, gt_points, &movement::MovementOptions::default()).context("movement metrics")?;
+    let frames = gen_world.iter().map(|c| c.frames).max().unwrap_or(120);
+    let count = gen_world.len();
+    let samples = reference.score(&gen_world, gen_points, None)?;
+    let clips = reference.clips_baseline()?;
+    let (mean_world, mean_points) = reference.mean_pose(count, frames);
+    let mean_pose = reference.score(&mean_world, &mean_points, None)?;
+    let (crop_world, crop_points) = reference.random_crops(count, frames, seed);
+    let crops = reference.score(&crop_world, &crop_points, None)?;
+    Ok(json!({
+        "threshold": reference.threshold,
+        "samples": samples,
+        "baselines": { "clips": clips, "mean_pose": mean_pose, "random_crops": crops },
     }))
 }
 

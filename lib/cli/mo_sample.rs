@@ -5,11 +5,11 @@ use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit::{self, KeepMask};
-use crate::diffusion::sample::{sample, SampleOptions};
+use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
 use crate::diffusion::{Sampler, Schedule};
 use crate::io::{self, npy};
-use crate::repr::anytop::{plant_feet, IkOptions, FEATURE_DIMS};
-use crate::repr::smooth::{lambda_for_cutoff, smooth_features};
+use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
+use crate::repr::smooth::lambda_for_cutoff;
 use crate::repr::Features;
 use crate::bvh;
 use anyhow::{bail, Context};
@@ -229,20 +229,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
     };
     let fixed = mask.as_ref().map(|m| m.keep.as_slice());
+    let post = PostProcess { smooth: lambda, blend, plant_feet: !args.no_plant_feet };
     for f in &mut samples {
-        if let Some(lambda) = lambda {
-            smooth_features(f, lambda, fixed, blend);
-        }
-        if !args.no_plant_feet {
-            plant_feet(f, &section.rig.feet, fixed);
-            if let Some(lambda) = lambda {
-                // Planting switches the root's velocity where feet land and lift: smooth the
-                // root again (its cells only), so that no jump is left where the set changes.
-                let joints = f.joints;
-                let others: Vec<bool> = (0..f.frames * joints).map(|k| k % joints != 0 || fixed.is_some_and(|m| m[k])).collect();
-                smooth_features(f, lambda, Some(&others), blend);
-            }
-        }
+        post.apply(f, &section.rig.feet, fixed);
     }
     if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {
         eprintln!("{}", seam_report(&section.rig, skeleton, r, mask, &samples)?);

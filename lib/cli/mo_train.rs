@@ -2,22 +2,17 @@
 
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
-use crate::cli::CommonOpts;
-use crate::diffusion::checkpoint::{self, CheckpointInfo, TrainedSkeleton};
+use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, RawClip, TrainSet};
-use crate::diffusion::train::{named_vars, train_step, AdamW};
-use crate::diffusion::Schedule;
+use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopResume, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::embed::NameTable;
-use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig};
-use crate::sata::{self, checkpoint::SataInfo, train::{FeatureScale, LossWeights}, SataConfig, SataModel};
+use crate::nn::DenoiserConfig;
+use crate::sata::trainer::{SataOptions, SataResume, SataTrainer};
+use crate::sata::SataConfig;
 use crate::skeleton::topology;
-use crate::synth::SplitMix64;
 use anyhow::{bail, Context};
 use candle_core::Device;
-use candle_nn::VarMap;
-use std::io::Write;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -164,30 +159,11 @@ impl Preset {
     }
 }
 
-/// The training ended on Ctrl-C or SIGTERM, after saving a checkpoint.
-#[derive(Debug, thiserror::Error)]
-#[error("interrupted at step {step}, checkpoint saved; --resume to continue")]
-pub struct Interrupted {
-    pub step: u64,
-}
-
 /// Exit code after an interruption (128 + SIGINT, what shells report for Ctrl-C).
 pub const INTERRUPTED_EXIT: u8 = 130;
 
-/// `run`, then the exit code: 130 after Ctrl-C, else as `cli::finish`.
-pub fn main(args: &Args) -> std::process::ExitCode {
-    match run(args) {
-        Err(e) if e.is::<Interrupted>() => {
-            eprintln!("mo-train: {e}");
-            std::process::ExitCode::from(INTERRUPTED_EXIT)
-        }
-        result => crate::cli::finish("mo-train", result),
-    }
-}
-
-/// Set by Ctrl-C / SIGTERM; `SAVING` while a checkpoint is being written.
-static STOP: AtomicBool = AtomicBool::new(false);
-static SAVING: AtomicBool = AtomicBool::new(false);
+/// Set by Ctrl-C / SIGTERM; the loop stops at the next step boundary.
+static STOP: StopFlag = StopFlag::new();
 
 /// Install the signal handler once per process: the first signal asks the loop to stop at
 /// the next step boundary; a second one quits at once unless a checkpoint is being written
@@ -196,23 +172,15 @@ fn catch_interrupts() -> anyhow::Result<()> {
     static INSTALLED: OnceLock<Result<(), String>> = OnceLock::new();
     let installed = INSTALLED.get_or_init(|| {
         ctrlc::set_handler(|| {
-            if STOP.swap(true, Ordering::SeqCst) && !SAVING.load(Ordering::SeqCst) {
+            if STOP.request() && !STOP.saving() {
                 eprintln!("\nmo-train: interrupted twice, quitting without saving (the last checkpoint is whole)");
                 crate::io::output::remove_temps_and_exit(INTERRUPTED_EXIT as i32);
             }
         })
         .map_err(|e| e.to_string())
     });
-    STOP.store(false, Ordering::SeqCst);
+    STOP.reset();
     installed.clone().map_err(|e| anyhow::anyhow!("cannot catch Ctrl-C: {e}"))
-}
-
-/// Run a checkpoint save with `SAVING` set, so a second Ctrl-C waits for it.
-fn save_guarded(save: impl FnOnce() -> anyhow::Result<()>) -> anyhow::Result<()> {
-    SAVING.store(true, Ordering::SeqCst);
-    let result = save();
-    SAVING.store(false, Ordering::SeqCst);
-    result
 }
 
 /// Seconds as `1h02m`, `3m05s` or `42s`.
@@ -244,173 +212,120 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.out.exists() && !args.out.is_dir() {
         bail!("--out {}: not a directory (the model directory to write)", args.out.display());
     }
-    let say = |msg: String| {
-        if !args.common.quiet {
-            eprintln!("mo-train: {msg}");
-        }
-    };
-    if args.arch == Arch::Sata {
-        return run_sata(args);
-    }
-    let crop = args.crop.unwrap_or(40);
     let device = Device::Cpu;
-    let schedule = Schedule::cosine(100);
-    let dmax = topology::DEFAULT_DMAX;
-    // The checkpoint first: a resumed run must rebuild the data (augmented variants included)
-    // from the seed the run started with.
-    let (varmap, model, opt, mut info) = if args.resume {
-        let loaded = checkpoint::load(&args.out, &device)?;
-        let opt = checkpoint::load_optimizer(&args.out, loaded.info.step, &device, args.lr)?;
-        let i = &loaded.info;
-        if i.batch as u64 != args.batch || i.crop as u64 != crop || i.seed != args.common.seed || i.augment != args.augment || i.augment_variants as u64 != args.augment_variants {
-            say("note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been".into());
-        }
-        (loaded.varmap, loaded.model, opt, loaded.info)
-    } else {
-        if args.out.join("checkpoint.json").exists() {
-            bail!("{} already holds a checkpoint: --resume to continue it, or choose another --out", args.out.display());
-        }
-        let varmap = VarMap::new();
-        let cfg = args.preset.config();
-        let model = Denoiser::new(seeded_var_builder(&varmap, args.common.seed, &device), &cfg)?;
-        let info = CheckpointInfo {
-            format: checkpoint::FORMAT.into(),
-            version: checkpoint::VERSION,
-            config: cfg,
-            step: 0,
-            seed: args.common.seed,
-            schedule_steps: schedule.len(),
-            lr: args.lr,
-            batch: args.batch as usize,
-            crop: crop as usize,
-            dmax,
-            augment: 0.0,
-            augment_variants: 0,
-            skeletons: Vec::new(),
-        };
-        (varmap, model, AdamW::new(args.lr), info)
-    };
-    info.augment = args.augment;
-    info.augment_variants = args.augment_variants as usize;
-
-    let set = training_set(args, info.seed, info.dmax)?;
-    info.skeletons = set
-        .skeletons
-        .iter()
-        .map(|s| TrainedSkeleton {
-            name: s.name.clone(),
-            joints: s.skeleton.joints.iter().map(|j| j.name.clone()).collect(),
-            parents: s.skeleton.parents(),
-            stats: s.stats.clone(),
-            clips: s.clips.len(),
-            offsets: s.skeleton.joints.iter().map(|j| j.offset.to_array()).collect(),
-        })
-        .collect();
-    let first = info.step;
-    let vars = named_vars(&varmap);
-    let mut trainer = AnyTopTrainer { args, info, varmap, model, vars, opt, set, schedule, crop: crop as usize, device };
-    train_loop(args, first, &mut trainer)
-}
-
-/// The data stream of step k depends only on the seed and k, so a resumed run draws what the
-/// uninterrupted one would have.
-fn step_rng(seed: u64, k: u64) -> SplitMix64 {
-    SplitMix64::new(seed ^ k.wrapping_mul(0x9e37_79b9_7f4a_7c15))
-}
-
-/// What the training loop drives, for either architecture.
-trait Trainer {
-    /// Step `k` (0-based): the loss, and extra `"name":value` pairs for the JSON log.
-    fn step(&mut self, k: u64) -> anyhow::Result<(f64, String)>;
-    /// Save a checkpoint saying `steps` steps are done.
-    fn save(&mut self, steps: u64) -> anyhow::Result<()>;
-}
-
-/// Steps from `first` to `--steps` with the log, progress, periodic checkpoints and Ctrl-C.
-fn train_loop(args: &Args, first: u64, trainer: &mut impl Trainer) -> anyhow::Result<()> {
-    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let mut log = std::fs::OpenOptions::new().create(true).append(true).open(args.out.join("log.jsonl")).context("cannot open the training log")?;
-    catch_interrupts()?;
-    let started = Instant::now();
-    let mut last_save = Instant::now();
-    let mut last_draw: Option<Instant> = None;
-    let every = Duration::from_secs_f64(args.checkpoint_minutes.max(0.0) * 60.0);
-    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr()) && !args.common.quiet;
-    let mut step = first;
-    while step < args.steps {
-        if STOP.load(Ordering::SeqCst) {
-            if terminal {
-                eprintln!();
+    let done = match args.arch {
+        Arch::Anytop => {
+            let opts = AnyTopOptions {
+                config: args.preset.config(),
+                seed: args.common.seed,
+                lr: args.lr,
+                batch: args.batch as usize,
+                crop: args.crop.unwrap_or(40) as usize,
+                lambda_geo: args.lambda_geo,
+                augment: args.augment,
+                augment_variants: args.augment_variants as usize,
+            };
+            // The checkpoint first: a resumed run must rebuild the data (augmented variants
+            // included) from the seed the run started with.
+            let resume = if args.resume { Some(AnyTopResume::load(&args.out, args.lr, &device)?) } else { None };
+            let (seed, dmax) = resume.as_ref().map_or((opts.seed, topology::DEFAULT_DMAX), |r| (r.info().seed, r.info().dmax));
+            if resume.as_ref().is_some_and(|r| r.differs(&opts)) {
+                say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
             }
-            save_guarded(|| trainer.save(step))?;
-            return Err(Interrupted { step }.into());
+            refuse_to_overwrite(args)?;
+            let set = training_set(args, seed, dmax)?;
+            let mut trainer = AnyTopTrainer::new(&args.out, &opts, resume, set, &device).map_err(explain)?;
+            train(args, trainer.first_step(), &mut trainer)
         }
-        let (loss, extra) = trainer.step(step)?;
-        step += 1;
-        let done = step - first;
-        let rate = done as f64 / started.elapsed().as_secs_f64().max(1e-9);
-        let eta = (args.steps - step) as f64 / rate.max(1e-9);
-        writeln!(log, "{{\"step\":{step},\"loss\":{loss}{extra},\"steps_per_second\":{rate:.4},\"elapsed\":{:.2}}}", started.elapsed().as_secs_f64())
-            .context("cannot write the training log")?;
-        if terminal {
-            // Redraw at most ten times a second: fast tiny models would flood the terminal.
-            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || step == args.steps {
-                let width = args.steps.to_string().len();
-                eprint!("\rmo-train: {} {step:>width$}/{}  loss {loss:.4}  {rate:.2} steps/s  ETA {}   ", bar(step, args.steps, 30), args.steps, duration(eta));
-                last_draw = Some(Instant::now());
+        Arch::Sata => {
+            let mut config = args.preset.sata();
+            if let Some(crop) = args.crop {
+                config.window = crop as usize;
+                config.overlap = config.overlap.min(config.window.saturating_sub(1) / 2);
             }
-        } else if !args.common.quiet && (step % 50 == 0 || step == args.steps) {
-            eprintln!("mo-train: step {step}/{}  loss {loss:.4}  {rate:.2} steps/s  ETA {}", args.steps, duration(eta));
+            let opts = SataOptions {
+                config,
+                seed: args.common.seed,
+                lr: args.lr,
+                batch: args.batch as usize,
+                augment: args.augment,
+                augment_variants: args.augment_variants as usize,
+                lambda_kl: args.lambda_kl,
+                lambda_cycle: args.lambda_cycle,
+            };
+            let resume = if args.resume { Some(SataResume::load(&args.out, args.lr, &device)?) } else { None };
+            if resume.as_ref().is_some_and(|r| r.differs(&opts)) {
+                say(args, "note: --batch, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
+            }
+            refuse_to_overwrite(args)?;
+            if resume.is_none() {
+                opts.config.validate()?;
+            }
+            let seed = resume.as_ref().map_or(opts.seed, |r| r.info().seed);
+            let set = training_set(args, seed, topology::DEFAULT_DMAX)?;
+            let mut trainer = SataTrainer::new(&args.out, &opts, resume, set, &device).map_err(explain)?;
+            train(args, trainer.first_step(), &mut trainer)
         }
-        if last_save.elapsed() >= every {
-            save_guarded(|| trainer.save(step))?;
-            last_save = Instant::now();
-        }
-    }
-    if terminal {
-        eprintln!();
-    }
-    save_guarded(|| trainer.save(step))?;
+    }?;
     if !args.common.quiet {
-        eprintln!("mo-train: saved step {step} to {}", args.out.display());
+        eprintln!("mo-train: saved step {done} to {}", args.out.display());
     }
     Ok(())
 }
 
-/// The denoiser's training state.
-struct AnyTopTrainer<'a> {
-    args: &'a Args,
-    info: CheckpointInfo,
-    varmap: VarMap,
-    model: Denoiser,
-    vars: std::collections::BTreeMap<String, candle_core::Var>,
-    opt: AdamW,
-    set: TrainSet,
-    schedule: Schedule,
-    crop: usize,
-    device: Device,
+fn say(args: &Args, msg: &str) {
+    if !args.common.quiet {
+        eprintln!("mo-train: {msg}");
+    }
 }
 
-impl Trainer for AnyTopTrainer<'_> {
-    fn step(&mut self, k: u64) -> anyhow::Result<(f64, String)> {
-        let mut rng = step_rng(self.info.seed, k);
-        let stats = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.schedule, &mut rng, self.args.batch as usize, self.crop, self.args.lambda_geo, &self.device)?;
-        Ok((stats.loss, String::new()))
+/// A new run never overwrites another's checkpoint (checked before the data is read).
+fn refuse_to_overwrite(args: &Args) -> anyhow::Result<()> {
+    if args.resume {
+        return Ok(());
     }
+    refuse_existing(&args.out).map_err(explain)
+}
 
-    fn save(&mut self, steps: u64) -> anyhow::Result<()> {
-        self.info.step = steps;
-        checkpoint::save(&self.args.out, &self.info, &self.varmap, &self.opt)
+/// The library's error, with the flag that helps where there is one, and exit code 130 after
+/// an interruption.
+fn explain(e: TrainError) -> anyhow::Error {
+    match e {
+        TrainError::CheckpointExists(dir) => anyhow::anyhow!("{} already holds a checkpoint: --resume to continue it, or choose another --out", dir.display()),
+        TrainError::Interrupted { .. } => Exit { code: INTERRUPTED_EXIT, message: format!("{e}; --resume to continue") }.into(),
+        e => e.into(),
     }
+}
+
+/// The loop with a progress bar on a terminal (a line every 50 steps otherwise) and Ctrl-C;
+/// returns the steps done.
+fn train(args: &Args, first: u64, trainer: &mut impl Trainer) -> anyhow::Result<u64> {
+    catch_interrupts()?;
+    let opts = LoopOptions { out: args.out.clone(), steps: args.steps, checkpoint_every: Duration::from_secs_f64(args.checkpoint_minutes.max(0.0) * 60.0) };
+    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr()) && !args.common.quiet;
+    let mut last_draw: Option<Instant> = None;
+    let result = train_loop(&opts, first, trainer, &STOP, |p| {
+        let (step, steps, loss, rate, eta) = (p.step, p.steps, p.loss, p.rate, duration(p.eta_seconds));
+        if terminal {
+            // Redraw at most ten times a second: fast tiny models would flood the terminal.
+            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || step == steps {
+                let width = steps.to_string().len();
+                eprint!("\rmo-train: {} {step:>width$}/{steps}  loss {loss:.4}  {rate:.2} steps/s  ETA {eta}   ", bar(step, steps, 30));
+                last_draw = Some(Instant::now());
+            }
+        } else if !args.common.quiet && (step % 50 == 0 || step == steps) {
+            eprintln!("mo-train: step {step}/{steps}  loss {loss:.4}  {rate:.2} steps/s  ETA {eta}");
+        }
+    });
+    if terminal {
+        eprintln!();
+    }
+    result.map_err(explain)
 }
 
 /// The clips of DATA grouped by skeleton, with augmented variants, as both architectures use.
 fn training_set(args: &Args, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
-    let say = |msg: String| {
-        if !args.common.quiet {
-            eprintln!("mo-train: {msg}");
-        }
-    };
+    let say = |msg: String| say(args, &msg);
     let files = expand_inputs(&args.data)?;
     let loaded = load_motions(&files, &LoadOptions::default())?;
     let clips: Vec<RawClip> = loaded.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
@@ -437,91 +352,4 @@ fn training_set(args: &Args, seed: u64, dmax: usize) -> anyhow::Result<TrainSet>
         }
     }
     Ok(set)
-}
-
-/// `mo-train --arch sata`: the autoencoder on the same data, bucketed by skeleton.
-fn run_sata(args: &Args) -> anyhow::Result<()> {
-    let device = Device::Cpu;
-    let (varmap, model, opt, mut info, set) = if args.resume {
-        let loaded = sata::checkpoint::load(&args.out, &device)?;
-        let opt = checkpoint::load_optimizer(&args.out, loaded.info.step, &device, args.lr)?;
-        let i = &loaded.info;
-        if i.batch as u64 != args.batch || i.seed != args.common.seed || i.augment != args.augment || i.augment_variants as u64 != args.augment_variants {
-            eprintln!("mo-train: note: --batch, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
-        }
-        let set = training_set(args, loaded.info.seed, topology::DEFAULT_DMAX)?;
-        // The checkpoint records the settings its latest steps ran with (a curriculum changes
-        // --augment or --lr between resumes; log.jsonl keeps the step-by-step history).
-        let info = SataInfo { lr: args.lr, batch: args.batch as usize, augment: args.augment, augment_variants: args.augment_variants as usize, ..loaded.info };
-        (loaded.varmap, loaded.model, opt, info, set)
-    } else {
-        if args.out.join("checkpoint.json").exists() {
-            bail!("{} already holds a checkpoint: --resume to continue it, or choose another --out", args.out.display());
-        }
-        let mut cfg = args.preset.sata();
-        if let Some(crop) = args.crop {
-            cfg.window = crop as usize;
-            cfg.overlap = cfg.overlap.min(cfg.window.saturating_sub(1) / 2);
-        }
-        cfg.validate()?;
-        let set = training_set(args, args.common.seed, topology::DEFAULT_DMAX)?;
-        // Measured once on the original data; a resumed run keeps the checkpoint's.
-        let raw = sata::train::raw_clips(&set);
-        let scale = FeatureScale::measure(raw.iter().map(|(f, rest)| (f, rest.as_slice())));
-        let varmap = VarMap::new();
-        let model = SataModel::new(seeded_var_builder(&varmap, args.common.seed, &device), &cfg)?;
-        let info = SataInfo {
-            format: sata::checkpoint::FORMAT.into(),
-            version: sata::checkpoint::VERSION,
-            config: cfg,
-            scale,
-            weights: LossWeights { kl: args.lambda_kl, cycle: args.lambda_cycle.unwrap_or(0.0), ..LossWeights::default() },
-            step: 0,
-            seed: args.common.seed,
-            lr: args.lr,
-            batch: args.batch as usize,
-            augment: args.augment,
-            augment_variants: args.augment_variants as usize,
-            skeletons: Vec::new(),
-        };
-        (varmap, model, AdamW::new(args.lr), info, set)
-    };
-    info.skeletons = set.skeletons.iter().map(|s| s.name.clone()).collect();
-    if let Some(w) = args.lambda_cycle {
-        info.weights.cycle = w;
-    }
-    // Inference reads a trained skeleton's motion with the rig it was trained with.
-    sata::rigs::KnownRigs::of_set(&set).write(&args.out)?;
-    let first = info.step;
-    let vars = named_vars(&varmap);
-    let mut trainer = SataTrainer { args, info, varmap, model, vars, opt, set, device };
-    train_loop(args, first, &mut trainer)
-}
-
-struct SataTrainer<'a> {
-    args: &'a Args,
-    info: SataInfo,
-    varmap: VarMap,
-    model: SataModel,
-    vars: std::collections::BTreeMap<String, candle_core::Var>,
-    opt: AdamW,
-    set: TrainSet,
-    device: Device,
-}
-
-impl Trainer for SataTrainer<'_> {
-    fn step(&mut self, k: u64) -> anyhow::Result<(f64, String)> {
-        let mut rng = step_rng(self.info.seed, k);
-        let l = sata::train::train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.info.scale, &self.info.weights, &mut rng, self.args.batch as usize, &self.device)?;
-        let extra = format!(
-            ",\"reconstruction\":{},\"root\":{},\"geodesic\":{},\"smooth\":{},\"contact\":{},\"penetration\":{},\"kl\":{},\"cycle\":{}",
-            l.reconstruction, l.root, l.geodesic, l.smooth, l.contact, l.penetration, l.kl, l.cycle
-        );
-        Ok((l.total, extra))
-    }
-
-    fn save(&mut self, steps: u64) -> anyhow::Result<()> {
-        self.info.step = steps;
-        checkpoint::save(&self.args.out, &self.info, &self.varmap, &self.opt)
-    }
 }

@@ -2,9 +2,9 @@
 //! clap commands of all tools (so man pages and completions are generated from the very
 //! definitions that parse the arguments).
 //!
-//! Exit codes: 0 ok; 2 usage, I/O or data error (1, a valid negative answer, arrives with the
-//! first tool that has one, e.g. a metrics check). Errors print
-//! as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
+//! Exit codes: 0 ok; 2 usage, I/O or data error; 130 for an interrupted `mo-train` ([`Exit`];
+//! 1, a valid negative answer, arrives with the first tool that has one, e.g. a metrics check).
+//! Errors print as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
 pub mod bounds;
 pub mod docs;
@@ -108,9 +108,23 @@ pub fn finish(tool: &str, result: anyhow::Result<()>) -> ExitCode {
             }
             let msg = format!("{e:#}").replace('\n', " ");
             eprintln!("{tool}: {msg}");
-            ExitCode::from(2)
+            ExitCode::from(exit_code(&e))
         }
     }
+}
+
+/// An error that ends a tool with its own exit code rather than 2, e.g. 130 for an
+/// interrupted `mo-train` (as coreutils' `UError::code`).
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct Exit {
+    pub code: u8,
+    pub message: String,
+}
+
+/// The exit code for `e`: an [`Exit`]'s anywhere in its chain, else 2.
+pub fn exit_code(e: &anyhow::Error) -> u8 {
+    e.chain().find_map(|c| c.downcast_ref::<Exit>()).map_or(2, |x| x.code)
 }
 
 fn is_broken_pipe(e: &anyhow::Error) -> bool {

@@ -5,7 +5,7 @@ use crate::augment::{self, Plan, RemoveAmount};
 use crate::cli::CommonOpts;
 use crate::document::SkeletonDocument;
 use crate::skeleton::Skeleton;
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use crate::{bvh, io};
 use anyhow::{bail, Context};
 use std::collections::BTreeSet;

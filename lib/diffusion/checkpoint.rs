@@ -5,10 +5,9 @@
 //! interrupted save never leaves a partial file.
 
 use super::train::AdamW;
-use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig};
+use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
 use crate::repr::anytop::AnyTopStats;
 use crate::skeleton::Skeleton;
-use anyhow::{bail, Context};
 use candle_core::Device;
 use candle_nn::VarMap;
 use serde::{Deserialize, Serialize};
@@ -16,6 +15,47 @@ use std::path::Path;
 
 pub const FORMAT: &str = "menagerie.denoiser";
 pub const VERSION: u32 = 1;
+
+/// What can go wrong reading or writing a model directory (`sata::checkpoint` and
+/// `sata::rigs` use it too). Messages name the file; `Model` says which model.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    #[error("{what}")]
+    Io { what: String, source: std::io::Error },
+    #[error("{what}")]
+    Tensor { what: String, source: candle_core::Error },
+    #[error("{what}")]
+    Json { what: String, source: serde_json::Error },
+    /// Readable, but not a model this version uses.
+    #[error("{0}")]
+    Invalid(String),
+    #[error("model.safetensors does not match checkpoint.json's config")]
+    Mismatch(#[source] NnError),
+    #[error(transparent)]
+    Config(#[from] NnError),
+    /// An error about one model: `model DIR`, `the built-in default model`.
+    #[error("{model}")]
+    Model { model: String, source: Box<CheckpointError> },
+}
+
+impl CheckpointError {
+    pub(crate) fn io(what: String) -> impl FnOnce(std::io::Error) -> CheckpointError {
+        move |source| CheckpointError::Io { what, source }
+    }
+
+    pub(crate) fn tensor(what: String) -> impl FnOnce(candle_core::Error) -> CheckpointError {
+        move |source| CheckpointError::Tensor { what, source }
+    }
+
+    pub(crate) fn json(what: String) -> impl FnOnce(serde_json::Error) -> CheckpointError {
+        move |source| CheckpointError::Json { what, source }
+    }
+
+    /// This error, said to be about `model`.
+    pub(crate) fn of(model: String) -> impl FnOnce(CheckpointError) -> CheckpointError {
+        move |e| CheckpointError::Model { model, source: Box::new(e) }
+    }
+}
 
 /// One trained skeleton: how to recognise it and its statistics.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -77,21 +117,21 @@ pub struct CheckpointInfo {
 /// interruption at any point leaves either the previous checkpoint's files or the new ones,
 /// never a partial file (the renames themselves are atomic).
 /// Any model's checkpoint (`sata::checkpoint` uses it too): `info` is its `checkpoint.json`.
-pub fn save(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &AdamW) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+pub fn save(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &AdamW) -> Result<(), CheckpointError> {
+    std::fs::create_dir_all(dir).map_err(CheckpointError::io(format!("cannot create {}", dir.display())))?;
     let tmp = |name: &str| dir.join(format!(".{name}.tmp"));
     let model = tmp("model.safetensors");
-    varmap.save(&model).with_context(|| format!("cannot write {}", model.display()))?;
+    varmap.save(&model).map_err(CheckpointError::tensor(format!("cannot write {}", model.display())))?;
     let state: std::collections::HashMap<String, candle_core::Tensor> = opt.state().into_iter().collect();
     let optimizer = tmp("optimizer.safetensors");
-    candle_core::safetensors::save(&state, &optimizer).with_context(|| format!("cannot write {}", optimizer.display()))?;
-    let text = serde_json::to_string_pretty(info).context("serialising the checkpoint info")?;
+    candle_core::safetensors::save(&state, &optimizer).map_err(CheckpointError::tensor(format!("cannot write {}", optimizer.display())))?;
+    let text = serde_json::to_string_pretty(info).map_err(CheckpointError::json("serialising the checkpoint info".into()))?;
     let json = tmp("checkpoint.json");
-    std::fs::write(&json, text + "\n").with_context(|| format!("cannot write {}", json.display()))?;
+    std::fs::write(&json, text + "\n").map_err(CheckpointError::io(format!("cannot write {}", json.display())))?;
     // The info goes last: a checkpoint.json always describes complete tensor files.
     for name in ["model.safetensors", "optimizer.safetensors", "checkpoint.json"] {
         let from = tmp(name);
-        std::fs::rename(&from, dir.join(name)).with_context(|| format!("cannot move {} into place", from.display()))?;
+        std::fs::rename(&from, dir.join(name)).map_err(CheckpointError::io(format!("cannot move {} into place", from.display())))?;
     }
     Ok(())
 }
@@ -104,17 +144,17 @@ pub struct Loaded {
 }
 
 /// Load `dir`'s info and model (the optimiser separately, with `load_optimizer`).
-pub fn load(dir: &Path, device: &Device) -> anyhow::Result<Loaded> {
+pub fn load(dir: &Path, device: &Device) -> Result<Loaded, CheckpointError> {
     let (info, weights) = read_dir_files(dir)?;
-    load_bytes(&info, &weights, device).with_context(|| format!("model {}", dir.display()))
+    load_bytes(&info, &weights, device).map_err(CheckpointError::of(format!("model {}", dir.display())))
 }
 
 /// The bytes of `dir`'s `checkpoint.json` and `model.safetensors`.
-pub fn read_dir_files(dir: &Path) -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
+pub fn read_dir_files(dir: &Path) -> Result<(Vec<u8>, Vec<u8>), CheckpointError> {
     let path = dir.join("checkpoint.json");
-    let info = std::fs::read(&path).with_context(|| format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display()))?;
+    let info = std::fs::read(&path).map_err(CheckpointError::io(format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display())))?;
     let weights = dir.join("model.safetensors");
-    let bytes = std::fs::read(&weights).with_context(|| format!("cannot read {}", weights.display()))?;
+    let bytes = std::fs::read(&weights).map_err(CheckpointError::io(format!("cannot read {}", weights.display())))?;
     Ok((info, bytes))
 }
 
@@ -122,21 +162,21 @@ pub fn read_dir_files(dir: &Path) -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
 pub const MAX_SCHEDULE_STEPS: usize = 10_000;
 
 /// `checkpoint.json`'s description, checked to be ours and of this version.
-fn parse_info(info_json: &[u8]) -> anyhow::Result<CheckpointInfo> {
-    let info: CheckpointInfo = serde_json::from_slice(info_json).context("checkpoint.json: not a checkpoint description")?;
+fn parse_info(info_json: &[u8]) -> Result<CheckpointInfo, CheckpointError> {
+    let info: CheckpointInfo = serde_json::from_slice(info_json).map_err(CheckpointError::json("checkpoint.json: not a checkpoint description".into()))?;
     if info.format != FORMAT || info.version != VERSION {
-        bail!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version);
+        return Err(CheckpointError::Invalid(format!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version)));
     }
     // The noise schedule is rebuilt from this count; 0 or 1 steps is no schedule at all.
     if !(2..=MAX_SCHEDULE_STEPS).contains(&info.schedule_steps) {
-        bail!("checkpoint.json: schedule_steps is {}, expected 2 to {MAX_SCHEDULE_STEPS}", info.schedule_steps);
+        return Err(CheckpointError::Invalid(format!("checkpoint.json: schedule_steps is {}, expected 2 to {MAX_SCHEDULE_STEPS}", info.schedule_steps)));
     }
     Ok(info)
 }
 
 /// A checkpoint from the bytes of its `checkpoint.json` and `model.safetensors` (the embedded
 /// default model has no directory).
-pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Loaded> {
+pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<Loaded, CheckpointError> {
     let info = parse_info(info_json)?;
     let varmap = VarMap::new();
     // Build every parameter (the seed does not matter: all are overwritten), then fill them.
@@ -147,15 +187,15 @@ pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::
 
 /// Overwrite every variable of `varmap` with the tensor of the same name in the safetensors
 /// bytes `weights`; a missing or misshapen one is an error.
-pub fn fill_vars(varmap: &VarMap, weights: &[u8], device: &Device) -> anyhow::Result<()> {
-    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
-    let vars = varmap.data().lock().map_err(|_| anyhow::anyhow!("the parameter map is poisoned"))?;
+pub fn fill_vars(varmap: &VarMap, weights: &[u8], device: &Device) -> Result<(), CheckpointError> {
+    let tensors = candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
+    let vars = varmap.data().lock().map_err(|_| CheckpointError::Invalid("the parameter map is poisoned".into()))?;
     for (name, var) in vars.iter() {
-        let Some(t) = tensors.get(name) else { bail!("model.safetensors: parameter {name} is missing") };
+        let Some(t) = tensors.get(name) else { return Err(CheckpointError::Invalid(format!("model.safetensors: parameter {name} is missing"))) };
         if t.dims() != var.dims() {
-            bail!("model.safetensors: parameter {name} is {:?}, the config needs {:?}", t.dims(), var.dims());
+            return Err(CheckpointError::Invalid(format!("model.safetensors: parameter {name} is {:?}, the config needs {:?}", t.dims(), var.dims())));
         }
-        var.set(t).with_context(|| format!("model.safetensors: parameter {name}"))?;
+        var.set(t).map_err(CheckpointError::tensor(format!("model.safetensors: parameter {name}")))?;
     }
     Ok(())
 }
@@ -171,32 +211,32 @@ pub struct Frozen {
 }
 
 /// `Frozen` from the bytes of `checkpoint.json` and `model.safetensors`.
-pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> anyhow::Result<Frozen> {
+pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<Frozen, CheckpointError> {
     let info = parse_info(info_json)?;
-    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
+    let tensors = candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
-    let model = Denoiser::new(vb, &info.config).context("model.safetensors does not match checkpoint.json's config")?;
+    let model = Denoiser::new(vb, &info.config).map_err(CheckpointError::Mismatch)?;
     Ok(Frozen { info, model })
 }
 
 /// `Frozen` from a model directory written by mo-train.
-pub fn frozen(dir: &Path, device: &Device) -> anyhow::Result<Frozen> {
+pub fn frozen(dir: &Path, device: &Device) -> Result<Frozen, CheckpointError> {
     let (info, weights) = read_dir_files(dir)?;
-    frozen_bytes(&info, &weights, device).with_context(|| format!("model {}", dir.display()))
+    frozen_bytes(&info, &weights, device).map_err(CheckpointError::of(format!("model {}", dir.display())))
 }
 
 /// The default model that ships inside the binaries: a `small` denoiser trained on the
 /// synthetic zoo (models/zoo-small, see its MODEL_CARD.md).
-pub fn frozen_default(device: &Device) -> anyhow::Result<Frozen> {
+pub fn frozen_default(device: &Device) -> Result<Frozen, CheckpointError> {
     const INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
     const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");
-    frozen_bytes(INFO, WEIGHTS, device).context("the built-in default model")
+    frozen_bytes(INFO, WEIGHTS, device).map_err(CheckpointError::of("the built-in default model".into()))
 }
 
 /// The optimiser state saved beside a checkpoint.
-pub fn load_optimizer(dir: &Path, step: u64, device: &Device, lr: f64) -> anyhow::Result<AdamW> {
+pub fn load_optimizer(dir: &Path, step: u64, device: &Device, lr: f64) -> Result<AdamW, CheckpointError> {
     let path = dir.join("optimizer.safetensors");
-    let tensors = candle_core::safetensors::load(&path, device).with_context(|| format!("cannot load {}", path.display()))?;
+    let tensors = candle_core::safetensors::load(&path, device).map_err(CheckpointError::tensor(format!("cannot load {}", path.display())))?;
     let mut opt = AdamW::new(lr);
     opt.load_state(&tensors, step);
     Ok(opt)

@@ -11,7 +11,7 @@ use crate::embed::NameTable;
 use crate::repr::anytop::{AnyTopStats, FEATURE_DIMS};
 use crate::repr::Features;
 use crate::skeleton::{topology, Skeleton};
-use anyhow::{bail, Context};
+use super::DiffusionError;
 
 /// Where the normalisation statistics came from (tools say so when it is the fallback).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,7 +38,7 @@ impl SkeletonCondition {
     /// The condition for `skeleton` under the model `info` describes. `rest_row` is the
     /// skeleton's P_S in physical units (J rows of 13); `measured` are statistics of the
     /// caller's own motion, used when the model was not trained on this skeleton.
-    pub fn new(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], measured: Option<&AnyTopStats>) -> anyhow::Result<SkeletonCondition> {
+    pub fn new(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], measured: Option<&AnyTopStats>) -> Result<SkeletonCondition, DiffusionError> {
         let (stats, stats_source) = match (find_trained(&info.skeletons, skeleton), measured) {
             (Some(t), _) => (t.stats.clone(), StatsSource::Trained),
             (None, Some(s)) => (s.clone(), StatsSource::Measured),
@@ -49,10 +49,10 @@ impl SkeletonCondition {
 
     /// The condition with the given statistics (e.g. always the caller's own, so that two
     /// motions compared with each other are normalised alike).
-    pub fn with_stats(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], stats: AnyTopStats, stats_source: StatsSource) -> anyhow::Result<SkeletonCondition> {
+    pub fn with_stats(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], stats: AnyTopStats, stats_source: StatsSource) -> Result<SkeletonCondition, DiffusionError> {
         let mut rest = Features { frames: 1, joints: skeleton.len(), dims: FEATURE_DIMS, data: rest_row.concat() };
-        stats.normalise(&mut rest).map_err(|e| anyhow::anyhow!("normalising the rest pose: {e}"))?;
-        let names = NameTable::builtin().context("the built-in joint-name table")?.embed_skeleton(skeleton);
+        stats.normalise(&mut rest).map_err(|source| DiffusionError::Stats { what: "normalising the rest pose", source })?;
+        let names = NameTable::builtin().map_err(DiffusionError::Names)?.embed_skeleton(skeleton);
         Ok(SkeletonCondition {
             rest_row: rest.data,
             relations: topology::relations(skeleton),
@@ -71,9 +71,9 @@ impl SkeletonCondition {
 /// Statistics for a skeleton nobody measured: its rest-pose row as the mean, and the average
 /// of the trained skeletons' (grouped) spreads — the root's from their roots, every other
 /// joint's from their non-root joints.
-pub fn fallback_stats(rest_row: &[Vec<f32>], trained: &[&AnyTopStats]) -> anyhow::Result<AnyTopStats> {
+pub fn fallback_stats(rest_row: &[Vec<f32>], trained: &[&AnyTopStats]) -> Result<AnyTopStats, DiffusionError> {
     if trained.is_empty() {
-        bail!("the model records no trained skeleton statistics");
+        return Err(DiffusionError::Invalid("the model records no trained skeleton statistics".into()));
     }
     let d = FEATURE_DIMS;
     let mut root = vec![0f32; d];

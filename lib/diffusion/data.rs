@@ -29,7 +29,7 @@ use crate::motion::Motion;
 use crate::repr::anytop::{self, AnyTopOptions, AnyTopStats, RestSource};
 use crate::repr::Features;
 use crate::skeleton::{topology, Skeleton};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use std::borrow::Cow;
 use std::path::Path;
 

@@ -10,6 +10,7 @@
 
 use super::sample::{denoise, Condition, Imposed, SampleOptions};
 use super::schedule::Schedule;
+use super::DiffusionError;
 use crate::nn::Denoiser;
 use crate::repr::Features;
 use crate::skeleton::{lookup, Skeleton};
@@ -186,7 +187,7 @@ pub fn sample_edit(
     reference: &Features,
     mask: &KeepMask,
     device: &Device,
-) -> anyhow::Result<Vec<Features>> {
+) -> Result<Vec<Features>, DiffusionError> {
     let joints = cond.names.len();
     let dims = reference.dims;
     if reference.joints != joints || dims != 13 || reference.frames < opts.frames || reference.data.len() != reference.frames * joints * dims {
@@ -203,7 +204,7 @@ pub fn sample_edit(
     let imposed = Imposed { reference: &normalised.data, known: &known, seed: opts.seed ^ 0x6564_6974_6b6e_6f77 };
     let mut out = denoise(model, schedule, cond, opts, Some(&imposed), device)?;
     for f in &mut out {
-        cond.stats.denormalise(f).map_err(|e| anyhow::anyhow!("denormalising the samples: {e}"))?;
+        cond.stats.denormalise(f).map_err(|source| DiffusionError::Stats { what: "denormalising the samples", source })?;
         // Normalising and back rounds; the kept cells are the reference's own numbers.
         for ((v, &r), _) in f.data.iter_mut().zip(&physical.data).zip(&known).filter(|(_, k)| **k) {
             *v = r;
@@ -372,7 +373,7 @@ mod tests {
         let j = skeleton.len();
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 3, &Device::Cpu), &DenoiserConfig::tiny()).unwrap();
-        let mut rng = crate::synth::SplitMix64::new(11);
+        let mut rng = crate::rng::SplitMix64::new(11);
         let frames = 10;
         let data: Vec<f32> = (0..frames * j * 13).map(|_| rng.range(-3.0, 3.0) as f32).collect();
         let stats = AnyTopStats { mean: (0..j * 13).map(|k| (k % 7) as f32 * 0.1).collect(), std: vec![2.0; j * 13] };

@@ -3,11 +3,13 @@
 //! (`schedule::Step`). The rest-pose token stays the skeleton's P_S throughout.
 
 use super::schedule::{Sampler, Schedule};
-use super::train::gaussian;
+use super::DiffusionError;
+use crate::rng::gaussian;
 use crate::nn::{batch_from, BatchItem, Denoiser};
-use crate::repr::anytop::AnyTopStats;
+use crate::repr::anytop::{plant_feet, AnyTopStats};
+use crate::repr::smooth::smooth_features;
 use crate::repr::Features;
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use candle_core::Device;
 
 /// What the model is told about the skeleton to animate (all normalised like training data).
@@ -31,10 +33,10 @@ pub struct SampleOptions {
 }
 
 /// `samples` motions, denormalised AnyTop features `[frames, joints, 13]` each.
-pub fn sample(model: &Denoiser, schedule: &Schedule, cond: &Condition, opts: &SampleOptions, device: &Device) -> anyhow::Result<Vec<Features>> {
+pub fn sample(model: &Denoiser, schedule: &Schedule, cond: &Condition, opts: &SampleOptions, device: &Device) -> Result<Vec<Features>, DiffusionError> {
     let mut x = denoise(model, schedule, cond, opts, None, device)?;
     for f in &mut x {
-        cond.stats.denormalise(f).map_err(|e| anyhow::anyhow!("denormalising the samples: {e}"))?;
+        cond.stats.denormalise(f).map_err(|source| DiffusionError::Stats { what: "denormalising the samples", source })?;
     }
     Ok(x)
 }
@@ -61,18 +63,19 @@ pub(super) fn denoise(
     opts: &SampleOptions,
     imposed: Option<&Imposed>,
     device: &Device,
-) -> anyhow::Result<Vec<Features>> {
+) -> Result<Vec<Features>, DiffusionError> {
     let joints = cond.names.len();
     let dims = model.config().feature_dims;
     let per = opts.frames * joints * dims;
     if let Some(k) = imposed {
-        anyhow::ensure!(
-            k.reference.len() == per && k.known.len() == per,
-            "the known motion has {} values and {} flags; sampling {} frames x {joints} joints x {dims} needs {per}",
-            k.reference.len(),
-            k.known.len(),
-            opts.frames
-        );
+        if k.reference.len() != per || k.known.len() != per {
+            return Err(DiffusionError::Invalid(format!(
+                "the known motion has {} values and {} flags; sampling {} frames x {joints} joints x {dims} needs {per}",
+                k.reference.len(),
+                k.known.len(),
+                opts.frames
+            )));
+        }
     }
     let mut rng = SplitMix64::new(opts.seed);
     let mut known_rng = imposed.map(|k| SplitMix64::new(k.seed));
@@ -124,4 +127,38 @@ pub(super) fn denoise(
         }
     }
     Ok(x)
+}
+
+/// What is done to sampled features before they are decoded: the model's frame-to-frame jitter
+/// smoothed away, and the root's travel taken from the planted feet so that they do not slide.
+/// `Default` is the raw output.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PostProcess {
+    /// The smoother's weight (`repr::smooth::lambda_for_cutoff` of a cutoff in Hz); none for
+    /// no smoothing.
+    pub smooth: Option<f64>,
+    /// Frames over which generated motion gives way to fixed cells (editing; see
+    /// `repr::smooth`).
+    pub blend: usize,
+    pub plant_feet: bool,
+}
+
+impl PostProcess {
+    /// Apply to one sample. `feet` are the rig's foot joints; `fixed` cells
+    /// (`[frame * joints + joint]`, an edit's kept part) keep their values.
+    pub fn apply(&self, f: &mut Features, feet: &[usize], fixed: Option<&[bool]>) {
+        if let Some(lambda) = self.smooth {
+            smooth_features(f, lambda, fixed, self.blend);
+        }
+        if self.plant_feet {
+            plant_feet(f, feet, fixed);
+            if let Some(lambda) = self.smooth {
+                // Planting switches the root's velocity where feet land and lift: smooth the
+                // root again (its cells only), so that no jump is left where the set changes.
+                let joints = f.joints;
+                let others: Vec<bool> = (0..f.frames * joints).map(|k| k % joints != 0 || fixed.is_some_and(|m| m[k])).collect();
+                smooth_features(f, lambda, Some(&others), self.blend);
+            }
+        }
+    }
 }

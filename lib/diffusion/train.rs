@@ -9,8 +9,8 @@
 
 use super::data::{Crop, TrainSet};
 use super::schedule::Schedule;
-use crate::nn::{batch_from, BatchItem, Denoiser};
-use crate::synth::SplitMix64;
+use crate::nn::{batch_from, BatchItem, Denoiser, NnError};
+use crate::rng::{gaussian, SplitMix64};
 use candle_core::cpu_backend::unary_map;
 use candle_core::{CpuStorage, CustomOp1, DType, Device, Layout, Shape, Tensor, Var};
 use candle_nn::VarMap;
@@ -91,21 +91,6 @@ pub fn named_vars(varmap: &VarMap) -> BTreeMap<String, Var> {
     data.iter().map(|(k, v)| (k.clone(), v.clone())).collect()
 }
 
-/// Standard normal values from `rng` (Box–Muller), as f32.
-pub fn gaussian(rng: &mut SplitMix64, n: usize) -> Vec<f32> {
-    let mut out = Vec::with_capacity(n + 1);
-    while out.len() < n {
-        let u1 = rng.unit().max(f64::MIN_POSITIVE);
-        let u2 = rng.unit();
-        let r = (-2.0 * u1.ln()).sqrt();
-        let a = std::f64::consts::TAU * u2;
-        out.push((r * a.cos()) as f32);
-        out.push((r * a.sin()) as f32);
-    }
-    out.truncate(n);
-    out
-}
-
 /// What one training step measured.
 #[derive(Clone, Copy, Debug)]
 pub struct StepStats {
@@ -131,7 +116,7 @@ pub fn training_loss(
     crop: usize,
     lambda_geo: f64,
     device: &Device,
-) -> anyhow::Result<Tensor> {
+) -> Result<Tensor, NnError> {
     let crops = set.sample(rng, batch, crop);
     let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
     let mut order: Vec<(usize, Option<usize>)> = Vec::new();
@@ -159,7 +144,7 @@ pub fn training_loss(
             },
         });
     }
-    let Some(sums) = total else { anyhow::bail!("an empty training batch") };
+    let Some(sums) = total else { return Err(NnError::Shape { what: "training batch", expected: "at least one crop".into(), got: vec![0] }) };
     let mse = (sums.squared / sums.values.max(1.0))?;
     match sums.rotation {
         Some(rotation) if lambda_geo != 0.0 => Ok((&mse + ((rotation / sums.tokens.max(1.0))? * lambda_geo)?)?),
@@ -177,7 +162,7 @@ struct LossSums {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, rotation: bool, device: &Device) -> anyhow::Result<LossSums> {
+fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, rotation: bool, device: &Device) -> Result<LossSums, NnError> {
     let features: Vec<_> = crops.iter().map(|c| set.crop(c)).collect();
     let items: Vec<BatchItem> = crops
         .iter()
@@ -228,7 +213,7 @@ fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Cro
     Ok(LossSums { squared, values, rotation: Some(rotation), tokens })
 }
 
-/// One training step: `training_loss`, backward, AdamW.
+/// One training step: `training_loss`, backward, AdamW; no update when the loss is not finite.
 #[allow(clippy::too_many_arguments)]
 pub fn train_step(
     model: &Denoiser,
@@ -241,11 +226,16 @@ pub fn train_step(
     crop: usize,
     lambda_geo: f64,
     device: &Device,
-) -> anyhow::Result<StepStats> {
+) -> Result<StepStats, NnError> {
     let loss = training_loss(model, set, schedule, rng, batch, crop, lambda_geo, device)?;
+    let value = loss.to_scalar::<f32>()? as f64;
+    if !value.is_finite() {
+        // No update from a NaN gradient: the caller stops with the model as it was.
+        return Ok(StepStats { loss: value });
+    }
     let grads = loss.backward()?;
     opt.update(vars, &grads)?;
-    Ok(StepStats { loss: loss.to_scalar::<f32>()? as f64 })
+    Ok(StepStats { loss: value })
 }
 
 /// The cosine argument is clamped to [−1 + ε, 1 − ε] before arccos, as the reference does, so

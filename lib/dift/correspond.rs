@@ -201,7 +201,7 @@ mod tests {
 
     #[test]
     fn the_matrix_product_agrees_with_the_plain_loop() {
-        let mut rng = crate::synth::SplitMix64::new(4);
+        let mut rng = crate::rng::SplitMix64::new(4);
         let mut rows = |n: usize| -> Vec<Vec<f32>> { (0..n).map(|_| (0..37).map(|_| rng.below(2001) as f32 / 1000.0 - 1.0).collect()).collect() };
         let (t, mut r) = (rows(23), rows(31));
         r[5] = vec![0.0; 37];

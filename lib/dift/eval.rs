@@ -11,7 +11,7 @@ use super::correspond::Match;
 use crate::embed::NameTable;
 use crate::motion::Motion;
 use crate::skeleton::{names, Joint, Skeleton};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use glam::DVec3;
 
 /// `skeleton` and `motion` with the joints in another valid file order — every joint's children
@@ -112,7 +112,7 @@ pub fn score_joints(matches: &[Match], truth: &[Option<usize>], mirror: &[Option
 }
 
 /// Names-only baseline descriptors: the joint names' text embeddings.
-pub fn name_descriptors(skeleton: &Skeleton) -> anyhow::Result<Vec<Vec<f32>>> {
+pub fn name_descriptors(skeleton: &Skeleton) -> Result<Vec<Vec<f32>>, crate::embed::EmbedError> {
     Ok(NameTable::builtin()?.embed_skeleton(skeleton))
 }
 

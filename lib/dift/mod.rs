@@ -16,16 +16,15 @@ pub mod eval;
 use crate::diffusion::checkpoint::CheckpointInfo;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::sample::Condition;
-use crate::diffusion::train::gaussian;
-use crate::diffusion::Schedule;
+use crate::rng::gaussian;
+use crate::diffusion::{DiffusionError, Schedule};
 use crate::document::AnyTopSection;
 use crate::motion::Motion;
-use crate::nn::{batch_from, BatchItem, Denoiser};
-use crate::repr::anytop::AnyTopStats;
+use crate::nn::{batch_from, BatchItem, Denoiser, NnError};
+use crate::repr::anytop::{AnyTopError, AnyTopStats};
 use crate::repr::Features;
 use crate::skeleton::Skeleton;
-use crate::synth::SplitMix64;
-use anyhow::{bail, Context};
+use crate::rng::SplitMix64;
 use candle_core::Device;
 
 /// Where and how to read the features.
@@ -41,6 +40,31 @@ pub struct DiftOptions {
     /// Place each draw at its own random temporal position (for frame descriptors: see
     /// `extract`); joint descriptors, averaged over time, do better without.
     pub shift: bool,
+}
+
+/// What can go wrong preparing a clip or extracting its features.
+#[derive(Debug, thiserror::Error)]
+pub enum DiftError {
+    /// Bad options or a clip of the wrong size.
+    #[error("{0}")]
+    Invalid(String),
+    /// Encoding or normalising a clip; `what` names it.
+    #[error("{what}")]
+    Repr { what: String, source: AnyTopError },
+    #[error("{file}")]
+    Condition { file: String, source: DiffusionError },
+    #[error(transparent)]
+    Nn(#[from] NnError),
+    #[error(transparent)]
+    Tensor(#[from] candle_core::Error),
+    #[error(transparent)]
+    Names(#[from] crate::embed::EmbedError),
+}
+
+impl DiftError {
+    fn repr(file: &str) -> impl FnOnce(AnyTopError) -> DiftError + '_ {
+        move |source| DiftError::Repr { what: file.to_string(), source }
+    }
 }
 
 impl DiftOptions {
@@ -163,21 +187,21 @@ pub struct Prepared {
 /// other by its own shifts all of its features alike, so a few reference joints become
 /// everyone's best match (measured: a quadruped against its own skel-aug variant, 5 of 21
 /// joints right with the training statistics for the original, 21 of 21 with each clip's own).
-pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file: &str) -> anyhow::Result<Prepared> {
+pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file: &str) -> Result<Prepared, DiftError> {
     if motion.frames < 2 {
-        bail!("{file}: {} frame(s); DIFT features need a motion of at least 2 frames", motion.frames);
+        return Err(DiftError::Invalid(format!("{file}: {} frame(s); DIFT features need a motion of at least 2 frames", motion.frames)));
     }
-    let section = AnyTopSection::of_clip(skeleton, motion, file).with_context(|| format!("{file}: cannot build an AnyTop rig"))?;
-    let features = section.rig.encode(skeleton, motion).map_err(|e| anyhow::anyhow!("{file}: {e}"))?.features;
+    let section = AnyTopSection::of_clip(skeleton, motion, file).map_err(|source| DiftError::Repr { what: format!("{file}: cannot build an AnyTop rig"), source })?;
+    let features = section.rig.encode(skeleton, motion).map_err(DiftError::repr(file))?.features;
     prepare_encoded(info, skeleton, &section.rest_row, features, file)
 }
 
 /// `prepare` for a motion already encoded (physical AnyTop features) with a rig whose P_S is
 /// `rest_row`, e.g. an NPY from `mo-encode` and its skeleton document.
-pub fn prepare_encoded(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], mut features: Features, file: &str) -> anyhow::Result<Prepared> {
-    let measured = AnyTopStats::compute([&features]).map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
-    let condition = SkeletonCondition::with_stats(info, skeleton, rest_row, measured, StatsSource::Measured).with_context(|| file.to_string())?;
-    condition.stats.normalise(&mut features).map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
+pub fn prepare_encoded(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], mut features: Features, file: &str) -> Result<Prepared, DiftError> {
+    let measured = AnyTopStats::compute([&features]).map_err(DiftError::repr(file))?;
+    let condition = SkeletonCondition::with_stats(info, skeleton, rest_row, measured, StatsSource::Measured).map_err(|source| DiftError::Condition { file: file.to_string(), source })?;
+    condition.stats.normalise(&mut features).map_err(DiftError::repr(file))?;
     Ok(Prepared { condition, features })
 }
 
@@ -191,26 +215,26 @@ const TOKENS_PER_PASS: usize = 48_000;
 /// DIFT features of a normalised motion (`Prepared::features`): the mean over `opts.draws`
 /// noise draws of the activations after `opts.layer` at step `opts.t`. Deterministic for
 /// `opts.seed`; draw k always takes the same noise whatever the batching.
-pub fn extract(model: &Denoiser, schedule: &Schedule, cond: &Condition, motion: &Features, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
+pub fn extract(model: &Denoiser, schedule: &Schedule, cond: &Condition, motion: &Features, opts: &DiftOptions, device: &Device) -> Result<DiftFeatures, DiftError> {
     let cfg = model.config();
     if opts.t >= schedule.len() {
-        bail!("diffusion step {} is past the schedule's last ({})", opts.t, schedule.len().saturating_sub(1));
+        return Err(DiftError::Invalid(format!("diffusion step {} is past the schedule's last ({})", opts.t, schedule.len().saturating_sub(1))));
     }
     if opts.layer >= cfg.layers {
-        bail!("layer {} does not exist: the model has layers 0..{}", opts.layer, cfg.layers.saturating_sub(1));
+        return Err(DiftError::Invalid(format!("layer {} does not exist: the model has layers 0..{}", opts.layer, cfg.layers.saturating_sub(1))));
     }
     if opts.draws == 0 {
-        bail!("at least one noise draw is needed");
+        return Err(DiftError::Invalid("at least one noise draw is needed".into()));
     }
     if motion.joints != cond.names.len() || motion.dims != cfg.feature_dims || motion.frames == 0 {
-        bail!(
+        return Err(DiftError::Invalid(format!(
             "the motion is [{}, {}, {}] but the skeleton has {} joints and the model reads {} features per joint",
             motion.frames,
             motion.joints,
             motion.dims,
             cond.names.len(),
             cfg.feature_dims
-        );
+        )));
     }
     let (a, b) = schedule.noise_coefficients(opts.t);
     let per = motion.data.len();

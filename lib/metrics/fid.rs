@@ -12,7 +12,7 @@
 //! by the **real** set's per-dimension mean and population std. [`FidOptions::normalise`]
 //! does that (default on). Definitions and deviations: `docs/metrics.md`.
 
-use super::linalg::{covariance, eigen_tolerance, matmul, sqrtm_psd, symmetric_eigenvalues, trace};
+use crate::linalg::{covariance, eigen_tolerance, matmul, sqrtm_psd, symmetric_eigenvalues, trace};
 use super::MetricError;
 
 /// A real-set dimension whose std is at most this fraction of max(1, |mean|) is constant:
@@ -130,7 +130,7 @@ fn check_set(set: &str, rows: &[Vec<f64>], dims: Option<usize>) -> Result<usize,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::SplitMix64;
+    use crate::rng::SplitMix64;
 
     fn random_set(n: usize, dims: usize, shift: f64, seed: u64) -> Vec<Vec<f64>> {
         let mut rng = SplitMix64::new(seed);

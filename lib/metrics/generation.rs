@@ -19,7 +19,7 @@
 
 use super::{Clip, MetricError};
 use crate::repr::anytop::{Facing, HUMANML_MEAN_BONE_LENGTH};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
 

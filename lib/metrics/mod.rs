@@ -10,7 +10,7 @@ pub mod fid;
 pub mod generation;
 pub mod geometric;
 pub mod kinetic;
-pub mod linalg;
+pub mod movement;
 pub mod physics;
 pub mod reconstruction;
 pub mod transfer;

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::nn::layers::softmax;
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use candle_core::{Device, Var, D};
 
 fn values(t: &Tensor) -> Result<Vec<f32>> {

@@ -5,7 +5,7 @@
 //! [`seeded_var_builder`] wraps a `VarMap` and creates each new parameter from SplitMix64
 //! seeded by (seed, parameter name): the values depend on neither creation order nor threads.
 
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use candle_core::{DType, Device, Result, Shape, Tensor, Var};
 use candle_nn::var_builder::SimpleBackend;
 use candle_nn::{Init, VarBuilder, VarMap};

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::repr::Features;
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 use candle_core::{Device, Tensor};
 use candle_nn::VarMap;
 

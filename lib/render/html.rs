@@ -392,7 +392,7 @@ fn base64(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::SplitMix64;
+    use crate::rng::SplitMix64;
     use glam::Vec3;
 
     /// A creature-like track: `points` points hanging off a root that walks a circle, each

@@ -24,7 +24,6 @@
 //! Frame rates are the caller's business: `resample` brings the source to the examples' rate.
 
 mod features;
-mod noise;
 mod nn;
 mod pyramid;
 pub mod settings;
@@ -36,6 +35,7 @@ pub use settings::{BoundRotation, Repr, RootMotion, Settings};
 use crate::binding::JointMap;
 use crate::motion::Motion;
 use crate::repr::m2m;
+use crate::rng::{stream_seed, PolarGaussian};
 use crate::skeleton::Skeleton;
 use features::Channels;
 use glam::DQuat;
@@ -404,9 +404,9 @@ impl<'a> Plan<'a> {
             let stream = stream as u64;
             let sigma = s.noise_sigma as f32;
             c.data.par_chunks_mut(c.width).enumerate().for_each(|(t, row)| {
-                let mut gauss = noise::Gaussian::new(noise::stream_seed(seed, stream, t as u64));
+                let mut gauss = PolarGaussian::new(stream_seed(seed, stream, t as u64));
                 for &k in &free {
-                    let x = row[k] + sigma * gauss.next();
+                    let x = row[k] + sigma * gauss.draw();
                     // fmod(x, 1) as the reference. The integer cast truncates like fmod without
                     // a library call; |x| is far below i64's range (sigma is at most 1e6).
                     row[k] = x - (x as i64) as f32;

@@ -345,7 +345,7 @@ fn pick(row: &[f32], norm: &[f32], query: usize, sample: Option<Sampling>) -> (u
     if best.is_empty() {
         return nearest(row, norm);
     }
-    let r = (super::noise::stream_seed(seed, 7, query as u64) % best.len() as u64) as usize;
+    let r = (crate::rng::stream_seed(seed, 7, query as u64) % best.len() as u64) as usize;
     let j = best[r].1;
     (j, row[j])
 }

@@ -5,9 +5,8 @@
 use super::rigs::KnownRigs;
 use super::train::{FeatureScale, LossWeights};
 use super::{SataConfig, SataModel};
-use crate::diffusion::checkpoint::{fill_vars, read_dir_files};
+use crate::diffusion::checkpoint::{fill_vars, read_dir_files, CheckpointError};
 use crate::nn::seeded_var_builder;
-use anyhow::{bail, Context};
 use candle_core::Device;
 use candle_nn::VarMap;
 use serde::{Deserialize, Serialize};
@@ -36,18 +35,18 @@ pub struct SataInfo {
 
 /// `checkpoint.json`, checked to be a SATA checkpoint of this version. A denoiser directory
 /// gets a message that says so.
-pub fn parse_info(json: &[u8]) -> anyhow::Result<SataInfo> {
-    let value: serde_json::Value = serde_json::from_slice(json).context("checkpoint.json: not JSON")?;
+pub fn parse_info(json: &[u8]) -> Result<SataInfo, CheckpointError> {
+    let value: serde_json::Value = serde_json::from_slice(json).map_err(CheckpointError::json("checkpoint.json: not JSON".into()))?;
     let format = value.get("format").and_then(|f| f.as_str()).unwrap_or("");
     if format != FORMAT {
-        bail!("checkpoint.json: format '{format}', expected '{FORMAT}' (a latent model from `mo-train --arch sata`)");
+        return Err(CheckpointError::Invalid(format!("checkpoint.json: format '{format}', expected '{FORMAT}' (a latent model from `mo-train --arch sata`)")));
     }
-    let info: SataInfo = serde_json::from_value(value).context("checkpoint.json: not a SATA checkpoint description")?;
+    let info: SataInfo = serde_json::from_value(value).map_err(CheckpointError::json("checkpoint.json: not a SATA checkpoint description".into()))?;
     if info.version != VERSION {
-        bail!("checkpoint.json: version {}, expected {VERSION}", info.version);
+        return Err(CheckpointError::Invalid(format!("checkpoint.json: version {}, expected {VERSION}", info.version)));
     }
     info.config.validate()?;
-    info.scale.check().map_err(|e| anyhow::anyhow!("checkpoint.json: {e}"))?;
+    info.scale.check().map_err(|e| CheckpointError::Invalid(format!("checkpoint.json: {e}")))?;
     Ok(info)
 }
 
@@ -58,12 +57,12 @@ pub struct Loaded {
     pub model: SataModel,
 }
 
-pub fn load(dir: &Path, device: &Device) -> anyhow::Result<Loaded> {
+pub fn load(dir: &Path, device: &Device) -> Result<Loaded, CheckpointError> {
     let (json, weights) = read_dir_files(dir)?;
-    let info = parse_info(&json).with_context(|| format!("model {}", dir.display()))?;
+    let info = parse_info(&json).map_err(CheckpointError::of(format!("model {}", dir.display())))?;
     let varmap = VarMap::new();
     let model = SataModel::new(seeded_var_builder(&varmap, 0, device), &info.config)?;
-    fill_vars(&varmap, &weights, device).with_context(|| format!("model {}", dir.display()))?;
+    fill_vars(&varmap, &weights, device).map_err(CheckpointError::of(format!("model {}", dir.display())))?;
     Ok(Loaded { info, varmap, model })
 }
 
@@ -76,18 +75,26 @@ pub struct Frozen {
 }
 
 /// `rigs`: the contents of `rigs.json`, if the model has one.
-pub fn frozen_bytes(json: &[u8], weights: &[u8], rigs: Option<&[u8]>, device: &Device) -> anyhow::Result<Frozen> {
+pub fn frozen_bytes(json: &[u8], weights: &[u8], rigs: Option<&[u8]>, device: &Device) -> Result<Frozen, CheckpointError> {
     let info = parse_info(json)?;
-    let tensors = candle_core::safetensors::load_buffer(weights, device).context("model.safetensors: not a safetensors file")?;
+    let tensors = candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
-    let model = SataModel::new(vb, &info.config).context("model.safetensors does not match checkpoint.json's config")?;
+    let model = SataModel::new(vb, &info.config).map_err(CheckpointError::Mismatch)?;
     let rigs = rigs.map(KnownRigs::parse).transpose()?.unwrap_or_default();
     Ok(Frozen { info, model, rigs })
 }
 
-pub fn frozen(dir: &Path, device: &Device) -> anyhow::Result<Frozen> {
+pub fn frozen(dir: &Path, device: &Device) -> Result<Frozen, CheckpointError> {
     let (json, weights) = read_dir_files(dir)?;
-    let mut model = frozen_bytes(&json, &weights, None, device).with_context(|| format!("model {}", dir.display()))?;
+    let mut model = frozen_bytes(&json, &weights, None, device).map_err(CheckpointError::of(format!("model {}", dir.display())))?;
     model.rigs = KnownRigs::read(dir)?;
     Ok(model)
+}
+
+/// The latent model that ships inside the binaries (models/zoo-sata, see its MODEL_CARD.md).
+pub fn frozen_default(device: &Device) -> Result<Frozen, CheckpointError> {
+    const INFO: &[u8] = include_bytes!("../../models/zoo-sata/checkpoint.json");
+    const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-sata/model.safetensors");
+    const RIGS: &[u8] = include_bytes!("../../models/zoo-sata/rigs.json");
+    frozen_bytes(INFO, WEIGHTS, Some(RIGS), device).map_err(CheckpointError::of("the built-in latent model".into()))
 }

@@ -4,7 +4,7 @@
 
 use super::checkpoint::Frozen;
 use super::graph::SkeletonGraph;
-use super::FEATURE_DIMS;
+use super::{SataError, FEATURE_DIMS};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::motion::Motion;
@@ -61,7 +61,7 @@ pub struct Prepared {
 }
 
 impl Prepared {
-    pub fn new(skeleton: &Skeleton, section: AnyTopSection, names: &NameTable, device: &Device) -> anyhow::Result<Prepared> {
+    pub fn new(skeleton: &Skeleton, section: AnyTopSection, names: &NameTable, device: &Device) -> Result<Prepared, SataError> {
         let graph = SkeletonGraph::new(skeleton, &section.rig, &names.embed_skeleton(skeleton), device)?;
         Ok(Prepared { section, graph })
     }
@@ -69,12 +69,12 @@ impl Prepared {
 
 impl Frozen {
     /// Latent means of raw AnyTop features `[frames, J, 13]` of the skeleton `g`.
-    pub fn encode_features(&self, features: &Features, g: &SkeletonGraph, device: &Device) -> anyhow::Result<Latents> {
+    pub fn encode_features(&self, features: &Features, g: &SkeletonGraph, device: &Device) -> Result<Latents, SataError> {
         if features.dims != FEATURE_DIMS || features.joints != g.joints {
-            anyhow::bail!("features are [{}, {}, {}], the skeleton needs [frames, {}, {FEATURE_DIMS}]", features.frames, features.joints, features.dims, g.joints);
+            return Err(SataError::Invalid(format!("features are [{}, {}, {}], the skeleton needs [frames, {}, {FEATURE_DIMS}]", features.frames, features.joints, features.dims, g.joints)));
         }
         if features.frames == 0 {
-            anyhow::bail!("no frames to encode");
+            return Err(SataError::Invalid("no frames to encode".into()));
         }
         let mut scaled = features.clone();
         self.info.scale.apply(&mut scaled, &g.rest);
@@ -102,16 +102,16 @@ impl Frozen {
     }
 
     /// Raw AnyTop features `[frames, J, 13]` of skeleton `g` from latents.
-    pub fn decode_latents(&self, latents: &Latents, g: &SkeletonGraph, device: &Device) -> anyhow::Result<Features> {
+    pub fn decode_latents(&self, latents: &Latents, g: &SkeletonGraph, device: &Device) -> Result<Features, SataError> {
         let l = self.info.config.latent;
         if latents.dims != l {
-            anyhow::bail!("latents have {} values per frame, the model's have {l}", latents.dims);
+            return Err(SataError::Invalid(format!("latents have {} values per frame, the model's have {l}", latents.dims)));
         }
         if latents.frames == 0 || latents.data.len() != latents.frames * l {
-            anyhow::bail!("latents: expected {} x {l} values, got {}", latents.frames, latents.data.len());
+            return Err(SataError::Invalid(format!("latents: expected {} x {l} values, got {}", latents.frames, latents.data.len())));
         }
         if let Some(k) = latents.data.iter().position(|v| !v.is_finite()) {
-            anyhow::bail!("latents: non-finite value at frame {}, dim {}", k / l, k % l);
+            return Err(SataError::Invalid(format!("latents: non-finite value at frame {}, dim {}", k / l, k % l)));
         }
         let per_frame = g.joints * FEATURE_DIMS;
         let mut out = Features::zeros(latents.frames, g.joints, FEATURE_DIMS);
@@ -136,7 +136,7 @@ impl Frozen {
 
     /// A motion of `target` that the latents describe, placed where the target's rest pose
     /// stands, with `frame_time`.
-    pub fn decode_motion(&self, latents: &Latents, target: &Skeleton, prepared: &Prepared, frame_time: f64, device: &Device) -> anyhow::Result<Motion> {
+    pub fn decode_motion(&self, latents: &Latents, target: &Skeleton, prepared: &Prepared, frame_time: f64, device: &Device) -> Result<Motion, SataError> {
         let features = self.decode_latents(latents, &prepared.graph, device)?;
         let rig = &prepared.section.rig;
         let mut motion = rig.decode(target, &features, &rig.rest_placement())?;

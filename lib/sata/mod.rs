@@ -30,11 +30,13 @@ pub mod infer;
 pub mod model;
 pub mod rigs;
 pub mod train;
+pub mod trainer;
 
 pub use graph::SkeletonGraph;
 pub use model::SataModel;
 
 use crate::nn::NnError;
+use crate::repr::anytop::AnyTopError;
 use serde::{Deserialize, Serialize};
 
 /// Hyper-parameters of the autoencoder; checkpoints carry it as JSON.
@@ -72,6 +74,21 @@ pub struct SataConfig {
 }
 
 /// AnyTop's 13 features per joint and frame.
+/// What can go wrong training or running the latent model (its files: `checkpoint`'s
+/// `CheckpointError`).
+#[derive(Debug, thiserror::Error)]
+pub enum SataError {
+    #[error(transparent)]
+    Nn(#[from] NnError),
+    #[error(transparent)]
+    Tensor(#[from] candle_core::Error),
+    #[error(transparent)]
+    Repr(#[from] AnyTopError),
+    /// Input of the wrong shape or values.
+    #[error("{0}")]
+    Invalid(String),
+}
+
 pub const FEATURE_DIMS: usize = 13;
 /// The model's motion input per joint: the 13 features and the change of the 6D rotation.
 pub const INPUT_DIMS: usize = FEATURE_DIMS + 6;

@@ -12,7 +12,7 @@
 use crate::diffusion::data::{offsets_agree, TrainSet};
 use crate::document::AnyTopSection;
 use crate::skeleton::Skeleton;
-use anyhow::{bail, Context};
+use crate::diffusion::checkpoint::CheckpointError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -90,31 +90,31 @@ impl KnownRigs {
         self.rigs.iter().find(|r| r.matches(s))
     }
 
-    pub fn parse(json: &[u8]) -> anyhow::Result<KnownRigs> {
-        let rigs: KnownRigs = serde_json::from_slice(json).context("rigs.json: not a list of trained rigs")?;
+    pub fn parse(json: &[u8]) -> Result<KnownRigs, CheckpointError> {
+        let rigs: KnownRigs = serde_json::from_slice(json).map_err(CheckpointError::json("rigs.json: not a list of trained rigs".into()))?;
         if rigs.format != FORMAT {
-            bail!("rigs.json: format '{}', expected '{FORMAT}'", rigs.format);
+            return Err(CheckpointError::Invalid(format!("rigs.json: format '{}', expected '{FORMAT}'", rigs.format)));
         }
         Ok(rigs)
     }
 
     /// `dir/rigs.json`; none (every clip gets its own rig) for models trained before it.
-    pub fn read(dir: &Path) -> anyhow::Result<KnownRigs> {
+    pub fn read(dir: &Path) -> Result<KnownRigs, CheckpointError> {
         let path = dir.join(FILE);
         match std::fs::read(&path) {
-            Ok(bytes) => KnownRigs::parse(&bytes).with_context(|| format!("model {}", dir.display())),
+            Ok(bytes) => KnownRigs::parse(&bytes).map_err(CheckpointError::of(format!("model {}", dir.display()))),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(KnownRigs::default()),
-            Err(e) => Err(e).with_context(|| format!("cannot read {}", path.display())),
+            Err(e) => Err(CheckpointError::io(format!("cannot read {}", path.display()))(e)),
         }
     }
 
     /// Write `dir/rigs.json` under a temporary name, then rename it into place.
-    pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    pub fn write(&self, dir: &Path) -> Result<(), CheckpointError> {
+        std::fs::create_dir_all(dir).map_err(CheckpointError::io(format!("cannot create {}", dir.display())))?;
         let tmp = dir.join(format!(".{FILE}.tmp"));
-        let text = serde_json::to_string(self).context("serialising the trained rigs")?;
-        std::fs::write(&tmp, text + "\n").with_context(|| format!("cannot write {}", tmp.display()))?;
-        std::fs::rename(&tmp, dir.join(FILE)).with_context(|| format!("cannot move {} into place", tmp.display()))
+        let text = serde_json::to_string(self).map_err(CheckpointError::json("serialising the trained rigs".into()))?;
+        std::fs::write(&tmp, text + "\n").map_err(CheckpointError::io(format!("cannot write {}", tmp.display())))?;
+        std::fs::rename(&tmp, dir.join(FILE)).map_err(CheckpointError::io(format!("cannot move {} into place", tmp.display())))
     }
 }
 
@@ -164,7 +164,8 @@ mod tests {
         assert!(back.find(&skeleton).is_some());
         std::fs::write(dir.join(FILE), br#"{"format":"something.else","rigs":[]}"#).unwrap();
         let err = KnownRigs::read(&dir).unwrap_err();
-        assert!(format!("{err:#}").contains("expected 'menagerie.sata.rigs'"), "{err:#}");
+        let why = std::error::Error::source(&err).map(|e| e.to_string()).unwrap_or_default();
+        assert!(err.to_string().starts_with("model ") && why.contains("expected 'menagerie.sata.rigs'"), "{err}: {why}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

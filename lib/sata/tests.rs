@@ -9,7 +9,8 @@ use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::nn::seeded_var_builder;
 use crate::repr::Features;
-use crate::synth::{self, SplitMix64};
+use crate::rng::SplitMix64;
+use crate::synth;
 use candle_core::{Device, Tensor};
 use candle_nn::VarMap;
 

@@ -10,11 +10,11 @@
 //! [`FeatureScale`] instead of per-skeleton statistics (see the module doc of `sata`).
 
 use super::graph::{rest_row, SkeletonGraph};
-use super::{SataModel, FEATURE_DIMS};
+use super::{SataError, SataModel, FEATURE_DIMS};
 use crate::diffusion::data::{Crop, TrainSet};
-use crate::diffusion::train::{gaussian, rotation_distance, AdamW};
+use crate::diffusion::train::{rotation_distance, AdamW};
 use crate::repr::Features;
-use crate::synth::SplitMix64;
+use crate::rng::{gaussian, SplitMix64};
 use candle_core::{Device, Tensor, Var};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -171,8 +171,8 @@ pub fn draw_crops(set: &TrainSet, rng: &mut SplitMix64, batch: usize, frames: us
 }
 
 /// Scaled features `[B, T, J, 13]` of same-skeleton crops (`rest`: their skeleton's rest row).
-pub fn batch_tensor(set: &TrainSet, crops: &[Crop], scale: &FeatureScale, rest: &[f32], device: &Device) -> anyhow::Result<Tensor> {
-    let first = crops.first().ok_or_else(|| anyhow::anyhow!("empty batch"))?;
+pub fn batch_tensor(set: &TrainSet, crops: &[Crop], scale: &FeatureScale, rest: &[f32], device: &Device) -> Result<Tensor, SataError> {
+    let first = crops.first().ok_or_else(|| SataError::Invalid("empty batch".into()))?;
     let sk = set.data(first);
     let mut data = Vec::new();
     for c in crops {
@@ -186,13 +186,13 @@ pub fn batch_tensor(set: &TrainSet, crops: &[Crop], scale: &FeatureScale, rest: 
 
 /// The loss of reconstructing `x` (scaled, `[B, T, J, 13]`) through the model, with the VAE's
 /// sampled latent (noise from `rng`); `scale` is `FeatureScale::tensor` for the skeleton.
-pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> anyhow::Result<(Tensor, SataLosses)> {
+pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> Result<(Tensor, SataLosses), SataError> {
     let (total, report, _) = loss_with_latent(model, x, g, scale, weights, rng)?;
     Ok((total, report))
 }
 
 /// [`loss`], also giving the latent mean `[B, T, latent]` (for [`cycle_loss`]).
-fn loss_with_latent(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> anyhow::Result<(Tensor, SataLosses, Tensor)> {
+fn loss_with_latent(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> Result<(Tensor, SataLosses, Tensor), SataError> {
     let (mu, logvar) = model.encode(x, g)?;
     let eps = Tensor::from_vec(gaussian(rng, mu.elem_count()), mu.shape(), mu.device())?;
     let z = (&mu + (logvar.clone() * 0.5)?.exp()?.mul(&eps)?)?;
@@ -244,7 +244,7 @@ fn loss_with_latent(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Te
 /// decoder to put a foreign skeleton's motion into a body it was not recorded on. The target
 /// is detached (the encoder is taught to read, not to make latents easy to cycle); the output
 /// on `other` is also kept above the floor. `scale`: `FeatureScale::tensor` for `other`.
-pub fn cycle_loss(model: &SataModel, mu: &Tensor, other: &SkeletonGraph, scale: &Tensor) -> anyhow::Result<Tensor> {
+pub fn cycle_loss(model: &SataModel, mu: &Tensor, other: &SkeletonGraph, scale: &Tensor) -> Result<Tensor, SataError> {
     let target = mu.detach();
     let y = model.decode(&target, other)?;
     let (again, _) = model.encode(&y, other)?;
@@ -266,7 +266,7 @@ pub fn cycle_loss(model: &SataModel, mu: &Tensor, other: &SkeletonGraph, scale: 
 /// the term costs about half a step, not a whole one.
 const CYCLE_CROPS: usize = 4;
 
-/// One training step: draw, loss, backward, AdamW.
+/// One training step: draw, loss, backward, AdamW; no update when the loss is not finite.
 #[allow(clippy::too_many_arguments)]
 pub fn train_step(
     model: &SataModel,
@@ -278,9 +278,9 @@ pub fn train_step(
     rng: &mut SplitMix64,
     batch: usize,
     device: &Device,
-) -> anyhow::Result<SataLosses> {
+) -> Result<SataLosses, SataError> {
     let crops = draw_crops(set, rng, batch, model.config().window);
-    let first = crops.first().ok_or_else(|| anyhow::anyhow!("the training set gave no crop"))?;
+    let first = crops.first().ok_or_else(|| SataError::Invalid("the training set gave no crop".into()))?;
     let sk = set.data(first);
     let g = SkeletonGraph::new(&sk.skeleton, &sk.section.rig, &sk.names, device)?;
     let x = batch_tensor(set, &crops, scale, &g.rest, device)?;
@@ -302,7 +302,8 @@ pub fn train_step(
         }
     }
     if !report.total.is_finite() {
-        anyhow::bail!("the loss is not finite ({report:?}) at skeleton {}", sk.name);
+        // No update from a NaN gradient: the caller stops with the model as it was.
+        return Ok(report);
     }
     let grads = total.backward()?;
     opt.update(vars, &grads)?;

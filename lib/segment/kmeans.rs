@@ -6,7 +6,7 @@
 //! independent of the order the seeding happened to find them in, and readable for time series.
 
 use super::{check_frames, SegmentError};
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 
 /// Lloyd iterations per restart at most; real clips converge in tens.
 pub const MAX_ITERATIONS: usize = 300;

@@ -1,5 +1,5 @@
 //! Principal component analysis of per-frame feature vectors, on the repository's own symmetric
-//! eigen solver (`metrics::linalg`): no linear-algebra dependency for one small decomposition.
+//! eigen solver (`linalg`): no linear-algebra dependency for one small decomposition.
 //!
 //! Of the two equivalent routes the cheaper one is taken: the `d × d` covariance when there are
 //! at least as many frames as dimensions, else the `n × n` Gram matrix of the centred frames
@@ -8,7 +8,7 @@
 //! `fix_signs`) so that the output does not depend on the route or on rounding.
 
 use super::{check_frames, SegmentError};
-use crate::metrics::linalg::symmetric_eigen;
+use crate::linalg::symmetric_eigen;
 
 /// Frames projected on the leading principal components.
 #[derive(Clone, Debug, PartialEq)]

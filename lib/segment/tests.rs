@@ -1,5 +1,5 @@
 use super::*;
-use crate::synth::SplitMix64;
+use crate::rng::SplitMix64;
 
 /// Frames that sit around `centres[i]` for `counts[i]` frames, in time order, in `dims`
 /// dimensions (centre values fill the first two, the rest is noise).

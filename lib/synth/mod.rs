@@ -40,6 +40,7 @@ mod training_tests;
 
 use crate::bvh::{self, Bvh, Channel};
 use crate::motion::Motion;
+use crate::rng::SplitMix64;
 use crate::skeleton::{Joint, Skeleton};
 use glam::{DMat3, DQuat, DVec3};
 use std::f64::consts::TAU;
@@ -123,46 +124,6 @@ fn round_values(bvh: &mut Bvh) {
 
 fn fnv1a(s: &str) -> u64 {
     s.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
-}
-
-/// splitmix64: tiny, fast, good enough for jitter, and fully specified here, so clips never
-/// change because a dependency changed its generator.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    pub fn new(seed: u64) -> SplitMix64 {
-        SplitMix64(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform integer in `0..n` (0 when `n` is 0), by the multiply-shift method (bias below
-    /// 2^-32 for any realistic `n`).
-    pub fn below(&mut self, n: usize) -> usize {
-        ((self.next_u64() as u128 * n as u128) >> 64) as usize
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [lo, hi).
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    /// `x` scaled by a random factor in [1 - frac, 1 + frac).
-    pub fn vary(&mut self, x: f64, frac: f64) -> f64 {
-        x * (1.0 + self.range(-frac, frac))
-    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,5 +1,6 @@
-//! Dense symmetric linear algebra for the metrics: eigen-decomposition, covariance and the
-//! square root of a positive semi-definite matrix, all in f64.
+//! Dense symmetric linear algebra for the metrics' FID and the segmenter's PCA:
+//! eigen-decomposition, covariance and the square root of a positive semi-definite matrix, all
+//! in f64.
 //!
 //! The Fréchet distance needs the trace of a matrix square root. The usual recipe
 //! (`scipy.linalg.sqrtm(S1 @ S2)`, then the real part) goes through a complex Schur form of a
@@ -302,7 +303,7 @@ mod tests {
     use super::*;
 
     fn random_symmetric(n: usize, seed: u64) -> Vec<f64> {
-        let mut rng = crate::synth::SplitMix64::new(seed);
+        let mut rng = crate::rng::SplitMix64::new(seed);
         let mut a = vec![0.0; n * n];
         for i in 0..n {
             for j in 0..=i {

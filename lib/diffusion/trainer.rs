@@ -1,0 +1,413 @@
+//! The training loop both models share (`mo-train`): one seeded data stream per step, a
+//! JSON-lines log, checkpoints at an interval and at the end, and a stop flag that a signal
+//! handler sets. It prints nothing: the caller sees each step through a callback. The
+//! denoiser's trainer is here too; the SATA autoencoder's is `sata::trainer`.
+//!
+//! A run that is stopped and resumed is bit-identical to one that was not: the data stream of
+//! step k depends only on the seed and k (`step_rng`), and a checkpoint carries the optimiser.
+
+use super::checkpoint::{self, CheckpointInfo, TrainedSkeleton};
+use super::data::TrainSet;
+use super::train::{named_vars, train_step, AdamW};
+use super::Schedule;
+use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
+use crate::rng::SplitMix64;
+use candle_core::{Device, Var};
+use candle_nn::VarMap;
+use serde::ser::{Serialize, SerializeMap, Serializer};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Why training stopped before its last step.
+#[derive(Debug, thiserror::Error)]
+pub enum TrainError {
+    #[error("cannot create {}", .0.display())]
+    CreateDir(PathBuf, #[source] std::io::Error),
+    #[error("cannot open the training log")]
+    OpenLog(#[source] std::io::Error),
+    #[error("cannot write the training log")]
+    WriteLog(#[source] std::io::Error),
+    /// A new run would overwrite the checkpoint of another.
+    #[error("{} already holds a checkpoint", .0.display())]
+    CheckpointExists(PathBuf),
+    /// The stop flag was set; the checkpoint of `step` was saved first.
+    #[error("interrupted at step {step}, checkpoint saved")]
+    Interrupted { step: u64 },
+    /// The loss of `step` was NaN or infinite. Nothing of that step was saved or logged:
+    /// the last checkpoint (`kept`, none when the run saved none yet) is the last good model.
+    #[error("the loss of step {step} is not finite ({losses}): training stopped, {}", match kept { Some(s) => format!("the checkpoint of step {s} is kept"), None => "no checkpoint was saved".to_string() })]
+    NonFinite { step: u64, losses: String, kept: Option<u64> },
+    #[error(transparent)]
+    Checkpoint(#[from] checkpoint::CheckpointError),
+    #[error(transparent)]
+    Nn(#[from] NnError),
+    /// From another model's training step (`sata::SataError`).
+    #[error(transparent)]
+    Model(Box<dyn std::error::Error + Send + Sync>),
+}
+
+/// The data stream of step k depends only on the seed and k, so a resumed run draws what the
+/// uninterrupted one would have.
+pub fn step_rng(seed: u64, k: u64) -> SplitMix64 {
+    SplitMix64::new(seed ^ k.wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
+/// What one step measured: the loss trained on, and its named parts for the log.
+#[derive(Clone, Debug, Default)]
+pub struct StepLosses {
+    pub total: f64,
+    pub parts: Vec<(&'static str, f64)>,
+}
+
+impl StepLosses {
+    fn describe(&self) -> String {
+        std::iter::once(("loss", self.total)).chain(self.parts.iter().copied()).map(|(n, v)| format!("{n} {v}")).collect::<Vec<_>>().join(", ")
+    }
+}
+
+/// What the training loop drives, for either architecture.
+pub trait Trainer {
+    /// Step `k` (0-based). A non-finite loss must leave the model as it was (no update), so
+    /// the loop can stop with the last good model.
+    fn step(&mut self, k: u64) -> Result<StepLosses, TrainError>;
+    /// Save a checkpoint saying `steps` steps are done.
+    fn save(&mut self, steps: u64) -> Result<(), TrainError>;
+}
+
+/// A stop request a signal handler can make, and whether a checkpoint is being written (so a
+/// second signal can wait for it rather than leave a save half done).
+#[derive(Debug, Default)]
+pub struct StopFlag {
+    stop: AtomicBool,
+    saving: AtomicBool,
+}
+
+impl StopFlag {
+    pub const fn new() -> StopFlag {
+        StopFlag { stop: AtomicBool::new(false), saving: AtomicBool::new(false) }
+    }
+
+    /// Ask the loop to stop at the next step boundary; true if that was already asked.
+    pub fn request(&self) -> bool {
+        self.stop.swap(true, Ordering::SeqCst)
+    }
+
+    pub fn requested(&self) -> bool {
+        self.stop.load(Ordering::SeqCst)
+    }
+
+    pub fn reset(&self) {
+        self.stop.store(false, Ordering::SeqCst);
+    }
+
+    /// True while the loop writes a checkpoint.
+    pub fn saving(&self) -> bool {
+        self.saving.load(Ordering::SeqCst)
+    }
+
+    fn guard<T>(&self, save: impl FnOnce() -> T) -> T {
+        self.saving.store(true, Ordering::SeqCst);
+        let result = save();
+        self.saving.store(false, Ordering::SeqCst);
+        result
+    }
+}
+
+/// How long to train and where the log and checkpoints go.
+#[derive(Clone, Debug)]
+pub struct LoopOptions {
+    /// The model directory: `log.jsonl` is appended to there.
+    pub out: PathBuf,
+    /// Steps in total, counting those a resumed run has done.
+    pub steps: u64,
+    /// Save a checkpoint at least this often.
+    pub checkpoint_every: Duration,
+}
+
+/// One finished step, for a progress display.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Steps done (1-based: the step just finished).
+    pub step: u64,
+    pub steps: u64,
+    pub loss: f64,
+    /// Steps per second since this run started.
+    pub rate: f64,
+    pub eta_seconds: f64,
+}
+
+/// One line of `log.jsonl`: step, loss, its parts, speed, elapsed seconds. Written by
+/// serde_json so the file stays JSON whatever the numbers are.
+struct LogLine<'a> {
+    step: u64,
+    losses: &'a StepLosses,
+    rate: f64,
+    elapsed: f64,
+}
+
+impl Serialize for LogLine<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(4 + self.losses.parts.len()))?;
+        map.serialize_entry("step", &self.step)?;
+        map.serialize_entry("loss", &self.losses.total)?;
+        for (name, value) in &self.losses.parts {
+            map.serialize_entry(name, value)?;
+        }
+        // The precision the log always had: speed and time are not worth 17 digits.
+        map.serialize_entry("steps_per_second", &((self.rate * 1e4).round() / 1e4))?;
+        map.serialize_entry("elapsed", &((self.elapsed * 1e2).round() / 1e2))?;
+        map.end()
+    }
+}
+
+/// Steps from `first` to `opts.steps` with the log, periodic checkpoints and the stop flag;
+/// `progress` is called after every step. Returns the steps done, all saved.
+pub fn train_loop(opts: &LoopOptions, first: u64, trainer: &mut impl Trainer, stop: &StopFlag, mut progress: impl FnMut(&Progress)) -> Result<u64, TrainError> {
+    std::fs::create_dir_all(&opts.out).map_err(|e| TrainError::CreateDir(opts.out.clone(), e))?;
+    let mut log = std::fs::OpenOptions::new().create(true).append(true).open(opts.out.join("log.jsonl")).map_err(TrainError::OpenLog)?;
+    let started = Instant::now();
+    let mut last_save = Instant::now();
+    let mut saved = (first > 0).then_some(first);
+    let mut step = first;
+    while step < opts.steps {
+        if stop.requested() {
+            stop.guard(|| trainer.save(step))?;
+            return Err(TrainError::Interrupted { step });
+        }
+        let losses = trainer.step(step)?;
+        step += 1;
+        if !losses.total.is_finite() {
+            return Err(TrainError::NonFinite { step, losses: losses.describe(), kept: saved });
+        }
+        let done = step - first;
+        let elapsed = started.elapsed().as_secs_f64();
+        let rate = done as f64 / elapsed.max(1e-9);
+        let eta_seconds = (opts.steps - step) as f64 / rate.max(1e-9);
+        let line = LogLine { step, losses: &losses, rate, elapsed };
+        let mut text = serde_json::to_vec(&line).map_err(|e| TrainError::WriteLog(e.into()))?;
+        text.push(b'\n');
+        log.write_all(&text).map_err(TrainError::WriteLog)?;
+        progress(&Progress { step, steps: opts.steps, loss: losses.total, rate, eta_seconds });
+        if last_save.elapsed() >= opts.checkpoint_every {
+            stop.guard(|| trainer.save(step))?;
+            saved = Some(step);
+            last_save = Instant::now();
+        }
+    }
+    stop.guard(|| trainer.save(step))?;
+    Ok(step)
+}
+
+/// Refuse to start a new run in a directory that holds another run's checkpoint.
+pub fn refuse_existing(dir: &Path) -> Result<(), TrainError> {
+    if dir.join("checkpoint.json").exists() {
+        return Err(TrainError::CheckpointExists(dir.to_path_buf()));
+    }
+    Ok(())
+}
+
+/// How to train the denoiser.
+#[derive(Clone, Debug)]
+pub struct AnyTopOptions {
+    /// The model for a new run (a resumed one keeps its checkpoint's).
+    pub config: DenoiserConfig,
+    pub seed: u64,
+    pub lr: f64,
+    pub batch: usize,
+    pub crop: usize,
+    /// Weight of the geodesic rotation loss next to the MSE.
+    pub lambda_geo: f64,
+    pub augment: f64,
+    pub augment_variants: usize,
+}
+
+/// A denoiser checkpoint to continue, with its optimiser state.
+pub struct AnyTopResume {
+    loaded: checkpoint::Loaded,
+    opt: AdamW,
+}
+
+impl AnyTopResume {
+    /// The checkpoint in `dir`; the optimiser continues with learning rate `lr`.
+    pub fn load(dir: &Path, lr: f64, device: &Device) -> Result<AnyTopResume, TrainError> {
+        let loaded = checkpoint::load(dir, device)?;
+        let opt = checkpoint::load_optimizer(dir, loaded.info.step, device, lr)?;
+        Ok(AnyTopResume { loaded, opt })
+    }
+
+    /// The training data must be rebuilt (augmented variants included) from the seed and
+    /// distance limit the run started with.
+    pub fn info(&self) -> &CheckpointInfo {
+        &self.loaded.info
+    }
+
+    /// Whether `opts` draw other data than the checkpoint's run did (then the resumed run is
+    /// not the one it would have been).
+    pub fn differs(&self, opts: &AnyTopOptions) -> bool {
+        let i = &self.loaded.info;
+        i.batch != opts.batch || i.crop != opts.crop || i.seed != opts.seed || i.augment != opts.augment || i.augment_variants != opts.augment_variants
+    }
+}
+
+/// The denoiser's training state.
+pub struct AnyTopTrainer {
+    out: PathBuf,
+    info: CheckpointInfo,
+    varmap: VarMap,
+    model: Denoiser,
+    vars: BTreeMap<String, Var>,
+    opt: AdamW,
+    set: TrainSet,
+    schedule: Schedule,
+    batch: usize,
+    crop: usize,
+    lambda_geo: f64,
+    device: Device,
+}
+
+impl AnyTopTrainer {
+    /// A new run (`resume` none; `out` must not hold a checkpoint) or the continuation of
+    /// `resume`, on `set`, saving to `out`. A new run's set is built with `opts.seed` and
+    /// `topology::DEFAULT_DMAX`, a resumed one's with its checkpoint's.
+    pub fn new(out: &Path, opts: &AnyTopOptions, resume: Option<AnyTopResume>, set: TrainSet, device: &Device) -> Result<AnyTopTrainer, TrainError> {
+        let schedule = Schedule::cosine(100);
+        let (varmap, model, opt, mut info) = match resume {
+            Some(r) => (r.loaded.varmap, r.loaded.model, r.opt, r.loaded.info),
+            None => {
+                refuse_existing(out)?;
+                let varmap = VarMap::new();
+                let model = Denoiser::new(seeded_var_builder(&varmap, opts.seed, device), &opts.config)?;
+                let info = CheckpointInfo {
+                    format: checkpoint::FORMAT.into(),
+                    version: checkpoint::VERSION,
+                    config: opts.config.clone(),
+                    step: 0,
+                    seed: opts.seed,
+                    schedule_steps: schedule.len(),
+                    lr: opts.lr,
+                    batch: opts.batch,
+                    crop: opts.crop,
+                    dmax: crate::skeleton::topology::DEFAULT_DMAX,
+                    augment: 0.0,
+                    augment_variants: 0,
+                    skeletons: Vec::new(),
+                };
+                (varmap, model, AdamW::new(opts.lr), info)
+            }
+        };
+        info.augment = opts.augment;
+        info.augment_variants = opts.augment_variants;
+        info.skeletons = set
+            .skeletons
+            .iter()
+            .map(|s| TrainedSkeleton {
+                name: s.name.clone(),
+                joints: s.skeleton.joints.iter().map(|j| j.name.clone()).collect(),
+                parents: s.skeleton.parents(),
+                stats: s.stats.clone(),
+                clips: s.clips.len(),
+                offsets: s.skeleton.joints.iter().map(|j| j.offset.to_array()).collect(),
+            })
+            .collect();
+        let vars = named_vars(&varmap);
+        Ok(AnyTopTrainer {
+            out: out.to_path_buf(),
+            info,
+            varmap,
+            model,
+            vars,
+            opt,
+            set,
+            schedule,
+            batch: opts.batch,
+            crop: opts.crop,
+            lambda_geo: opts.lambda_geo,
+            device: device.clone(),
+        })
+    }
+
+    /// Steps done before this run (0 for a new one).
+    pub fn first_step(&self) -> u64 {
+        self.info.step
+    }
+}
+
+impl Trainer for AnyTopTrainer {
+    fn step(&mut self, k: u64) -> Result<StepLosses, TrainError> {
+        let mut rng = step_rng(self.info.seed, k);
+        let stats = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.schedule, &mut rng, self.batch, self.crop, self.lambda_geo, &self.device)?;
+        Ok(StepLosses { total: stats.loss, parts: Vec::new() })
+    }
+
+    fn save(&mut self, steps: u64) -> Result<(), TrainError> {
+        self.info.step = steps;
+        Ok(checkpoint::save(&self.out, &self.info, &self.varmap, &self.opt)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Losses from a list; counts saves.
+    struct Scripted {
+        losses: Vec<f64>,
+        saves: Vec<u64>,
+    }
+
+    impl Trainer for Scripted {
+        fn step(&mut self, k: u64) -> Result<StepLosses, TrainError> {
+            Ok(StepLosses { total: self.losses[k as usize], parts: vec![("part", self.losses[k as usize] / 2.0)] })
+        }
+
+        fn save(&mut self, steps: u64) -> Result<(), TrainError> {
+            self.saves.push(steps);
+            Ok(())
+        }
+    }
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("menagerie-trainer-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        d
+    }
+
+    #[test]
+    fn a_non_finite_loss_stops_without_saving_or_logging_it() {
+        for bad in [f64::NAN, f64::INFINITY] {
+            let out = dir("nan");
+            let opts = LoopOptions { out: out.clone(), steps: 5, checkpoint_every: Duration::ZERO };
+            let mut t = Scripted { losses: vec![1.0, 0.5, bad, 0.25, 0.1], saves: Vec::new() };
+            let mut seen = Vec::new();
+            let err = train_loop(&opts, 0, &mut t, &StopFlag::new(), |p| seen.push(p.step)).unwrap_err();
+            assert!(matches!(err, TrainError::NonFinite { step: 3, kept: Some(2), .. }), "{err}");
+            assert_eq!((t.saves.as_slice(), seen.as_slice()), (&[1, 2][..], &[1, 2][..]), "the bad step is neither saved nor reported");
+            let log = std::fs::read_to_string(out.join("log.jsonl")).unwrap();
+            let lines: Vec<serde_json::Value> = log.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+            assert_eq!(lines.len(), 2);
+            assert_eq!((lines[1]["step"].as_u64(), lines[1]["loss"].as_f64(), lines[1]["part"].as_f64()), (Some(2), Some(0.5), Some(0.25)));
+            let _ = std::fs::remove_dir_all(&out);
+        }
+    }
+
+    #[test]
+    fn a_stop_request_saves_at_the_step_boundary() {
+        let out = dir("stop");
+        let opts = LoopOptions { out: out.clone(), steps: 5, checkpoint_every: Duration::from_secs(3600) };
+        let mut t = Scripted { losses: vec![1.0; 5], saves: Vec::new() };
+        let stop = StopFlag::new();
+        let err = train_loop(&opts, 1, &mut t, &stop, |p| {
+            if p.step == 3 {
+                stop.request();
+            }
+        })
+        .unwrap_err();
+        assert!(matches!(err, TrainError::Interrupted { step: 3 }), "{err}");
+        assert_eq!(t.saves, [3]);
+        assert!(!stop.saving());
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
