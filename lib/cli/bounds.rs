@@ -52,7 +52,11 @@ fn number(text: &str) -> Result<f64, String> {
 pub fn positive(max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync + 'static {
     move |text| {
         let v = number(text)?;
-        if v > 0.0 && v <= max { Ok(v) } else { Err(format!("expected a number above 0 and at most {max}, found {text}")) }
+        match () {
+            _ if v > 0.0 && v <= max => Ok(v),
+            _ if max == f64::MAX => Err(format!("expected a number above 0, found {text}")),
+            _ => Err(format!("expected a number above 0 and at most {max}, found {text}")),
+        }
     }
 }
 
