@@ -94,6 +94,11 @@ pub struct Args {
     /// joint rotations) next to the MSE; the reference trains with 1.
     #[arg(long, value_name = "W", default_value_t = 1.0)]
     pub lambda_geo: f64,
+    /// Weight of a velocity loss next to the MSE: the squared error of the prediction's
+    /// frame-to-frame changes against the motion's (normalised units; MDM's, not in AnyTop's
+    /// reference). 0 = off. Not kept in the checkpoint: give it again with --resume.
+    #[arg(long, value_name = "W", default_value_t = 0.0)]
+    pub lambda_vel: f64,
     /// Chance that a training draw uses an augmented skeleton (joints removed or added), as a
     /// number in [0, 1] or a fraction like 2/3.
     #[arg(long, value_name = "P", default_value = "2/3", value_parser = parse_probability)]
@@ -207,6 +212,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if !(args.lr.is_finite() && args.lr > 0.0) {
         bail!("--lr must be a positive number, found {}", args.lr);
     }
+    for (flag, w) in [("--lambda-geo", args.lambda_geo), ("--lambda-vel", args.lambda_vel)] {
+        if !(w.is_finite() && w >= 0.0) {
+            bail!("{flag} must be a weight >= 0, found {w}");
+        }
+    }
     let device = Device::Cpu;
     let done = match args.arch {
         Arch::Anytop => {
@@ -217,6 +227,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 batch: args.batch as usize,
                 crop: args.crop.unwrap_or(40) as usize,
                 lambda_geo: args.lambda_geo,
+                lambda_vel: args.lambda_vel,
                 augment: args.augment,
                 augment_variants: args.augment_variants as usize,
             };
