@@ -11,6 +11,7 @@ complete -c mo-train -l lambda-kl -d 'sata: weight of the KL term that keeps the
 complete -c mo-train -l lambda-cycle -d 'sata: weight of the cross-skeleton latent cycle (a motion\'s latent decoded onto another training skeleton and encoded again should come back). Default 0 for a new run (tried at 1 for 1,100 steps: transfers moved less, models/zoo-sata/MODEL_CARD.md); a resumed run keeps its checkpoint\'s unless this is given' -r
 complete -c mo-train -l lr -d 'Learning rate' -r
 complete -c mo-train -l lambda-geo -d 'Weight of the geodesic rotation loss (the angle, in radians, between predicted and true joint rotations) next to the MSE; the reference trains with 1' -r
+complete -c mo-train -l lambda-vel -d 'Weight of a velocity loss next to the MSE: the squared error of the prediction\'s frame-to-frame changes against the motion\'s (normalised units; MDM\'s, not in AnyTop\'s reference). 0 = off. Not kept in the checkpoint: give it again with --resume' -r
 complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3' -r
 complete -c mo-train -l augment-variants -d 'Augmented variants prepared per skeleton (alternately removing and adding joints)' -r
 complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this often' -r

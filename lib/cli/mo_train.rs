@@ -97,6 +97,11 @@ pub struct Args {
     /// joint rotations) next to the MSE; the reference trains with 1.
     #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
     pub lambda_geo: f64,
+    /// Weight of a velocity loss next to the MSE: the squared error of the prediction's
+    /// frame-to-frame changes against the motion's (normalised units; MDM's, not in AnyTop's
+    /// reference). 0 = off. Not kept in the checkpoint: give it again with --resume.
+    #[arg(long, value_name = "W", default_value_t = 0.0, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
+    pub lambda_vel: f64,
     /// Chance that a training draw uses an augmented skeleton (joints removed or added), as a
     /// number in [0, 1] or a fraction like 2/3.
     #[arg(long, value_name = "P", default_value = "2/3", value_parser = parse_probability)]
@@ -214,6 +219,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.out.exists() && !args.out.is_dir() {
         bail!("--out {}: not a directory (the model directory to write)", args.out.display());
     }
+    for (flag, w) in [("--lambda-geo", args.lambda_geo), ("--lambda-vel", args.lambda_vel)] {
+        if !(w.is_finite() && w >= 0.0) {
+            bail!("{flag} must be a weight >= 0, found {w}");
+        }
+    }
     let device = Device::Cpu;
     let done = match args.arch {
         Arch::Anytop => {
@@ -224,6 +234,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 batch: args.batch as usize,
                 crop: args.crop.unwrap_or(40) as usize,
                 lambda_geo: args.lambda_geo,
+                lambda_vel: args.lambda_vel,
                 augment: args.augment,
                 augment_variants: args.augment_variants as usize,
             };

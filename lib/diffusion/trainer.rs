@@ -220,6 +220,8 @@ pub struct AnyTopOptions {
     pub crop: usize,
     /// Weight of the geodesic rotation loss next to the MSE.
     pub lambda_geo: f64,
+    /// Weight of the velocity loss (frame-to-frame changes) next to the MSE.
+    pub lambda_vel: f64,
     pub augment: f64,
     pub augment_variants: usize,
 }
@@ -265,6 +267,7 @@ pub struct AnyTopTrainer {
     batch: usize,
     crop: usize,
     lambda_geo: f64,
+    lambda_vel: f64,
     device: Device,
 }
 
@@ -325,6 +328,7 @@ impl AnyTopTrainer {
             batch: opts.batch,
             crop: opts.crop,
             lambda_geo: opts.lambda_geo,
+            lambda_vel: opts.lambda_vel,
             device: device.clone(),
         })
     }
@@ -338,7 +342,7 @@ impl AnyTopTrainer {
 impl Trainer for AnyTopTrainer {
     fn step(&mut self, k: u64) -> Result<StepLosses, TrainError> {
         let mut rng = step_rng(self.info.seed, k);
-        let stats = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.schedule, &mut rng, self.batch, self.crop, self.lambda_geo, &self.device)?;
+        let stats = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.schedule, &mut rng, self.batch, self.crop, self.lambda_geo, self.lambda_vel, &self.device)?;
         Ok(StepLosses { total: stats.loss, parts: Vec::new() })
     }
 
