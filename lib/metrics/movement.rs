@@ -25,7 +25,7 @@
 //! any thread count (parallel loops fill per-item slots, reductions run in order).
 
 use super::generation::PointClip;
-use super::physics::{contacts, PhysicsOptions};
+use super::physics::{contacts, Ground, PhysicsOptions};
 use super::{Clip, MetricError};
 use crate::rng::SplitMix64;
 use glam::DVec3;
@@ -42,13 +42,15 @@ pub struct MovementOptions {
     pub max_reference_frames: usize,
     /// At most this many windows on either side of a window search (evenly strided).
     pub max_windows: usize,
-    /// Contact thresholds (fractions of the body size), as `mo-metrics physics`.
+    /// Contact thresholds (fractions of the body size), as `mo-metrics physics`, with the
+    /// ground estimated from the motion: a creature whose feet never reach y = 0 (the zoo's
+    /// spider stands on its foot tips' end sites, above its foot joints) still steps.
     pub contact: PhysicsOptions,
 }
 
 impl Default for MovementOptions {
     fn default() -> Self {
-        MovementOptions { smooth_frames: 5, window: 15, max_reference_frames: 4000, max_windows: 2000, contact: PhysicsOptions::default() }
+        MovementOptions { smooth_frames: 5, window: 15, max_reference_frames: 4000, max_windows: 2000, contact: PhysicsOptions { ground: Ground::Estimate, ..PhysicsOptions::default() } }
     }
 }
 
