@@ -88,6 +88,9 @@ pub struct Reference<'a> {
     /// distance to the nearest window of the other clips, at least `threshold`.
     targets: Vec<(usize, usize)>,
     thresholds: Vec<f64>,
+    /// Windows with a window of another clip at a finite distance: those the other clips
+    /// cover, since each threshold is at least that distance.
+    covered_by_others: usize,
     /// The median of the clip windows' nearest-window distances, in the point clips' units:
     /// the smallest threshold asked for (zoo clips repeat one another exactly, and a sample
     /// need not be closer to them than the clips typically are to each other).
@@ -215,12 +218,11 @@ impl<'a> Reference<'a> {
         // the nearest window of the same clip that does not overlap it in time (a walk repeats
         // itself a cycle later). Not the same clip where there are several: the zoo's clips
         // are exactly periodic, so a window's own clip a cycle later would match perfectly.
-        let candidates = windows(points, w, opts.max_windows);
         let single = points.len() == 1;
         let nearest: Vec<f64> = targets
             .par_iter()
             .map(|&(c, s)| {
-                candidates
+                targets
                     .iter()
                     .filter(|&&(d, t)| if single { t.abs_diff(s) >= w } else { d != c })
                     .map(|&(d, t)| window_distance(&points[c], s, &points[d], t, w))
@@ -238,7 +240,8 @@ impl<'a> Reference<'a> {
         // A window nothing else resembles (infinite distance: a one-clip skeleton's window
         // with no other far enough away) is judged at the floor.
         let thresholds = nearest.iter().map(|&d| if d.is_finite() { d.max(floor) } else { floor }).collect();
-        Ok(Reference { clips, points, energy, poses, targets, thresholds, threshold: floor, opts: opts.clone() })
+        let covered_by_others = nearest.iter().filter(|d| d.is_finite()).count();
+        Ok(Reference { clips, points, energy, poses, targets, thresholds, covered_by_others, threshold: floor, opts: opts.clone() })
     }
 
     /// The clips' mean energy, sizes per second.
@@ -277,23 +280,10 @@ impl<'a> Reference<'a> {
     }
 
     /// Percent of the clip windows that the other clips cover: 100 by the thresholds'
-    /// construction (each is at least the distance to the nearest other clip's window); the
-    /// clips' own row of the report, computed rather than assumed.
+    /// construction, less any window no other clip has a window for (a one-clip skeleton's
+    /// window with none far enough away); the clips' own row of the report.
     fn coverage_leave_one_out(&self) -> f64 {
-        let w = self.opts.window;
-        let candidates = windows(self.points, w, self.opts.max_windows);
-        let single = self.points.len() == 1;
-        let covered = (0..self.targets.len())
-            .into_par_iter()
-            .filter(|&i| {
-                let (c, s) = self.targets[i];
-                candidates
-                    .iter()
-                    .filter(|&&(d, t)| if single { t.abs_diff(s) >= w } else { d != c })
-                    .any(|&(d, t)| window_distance(&self.points[c], s, &self.points[d], t, w) <= self.thresholds[i])
-            })
-            .count();
-        100.0 * covered as f64 / self.targets.len().max(1) as f64
+        100.0 * self.covered_by_others as f64 / self.targets.len().max(1) as f64
     }
 
     /// Score `motions` (world clips and the same as point clips, in one order) against the
@@ -341,13 +331,20 @@ impl<'a> Reference<'a> {
         if self.clips.len() == 1 {
             return self.score(self.clips, self.points, None);
         }
-        let parts: Vec<Movement> = (0..self.clips.len())
-            .map(|i| self.score(std::slice::from_ref(&self.clips[i]), std::slice::from_ref(&self.points[i]), Some(i)))
-            .collect::<Result<_, _>>()?;
+        // Per clip, against the others: nearest pose and contact (coverage is the whole set's,
+        // from the thresholds; energy is the clips' own).
+        let parts: Vec<(f64, Option<f64>, Option<f64>)> = self
+            .clips
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let (duty, mixed) = contact_stats(c, &self.opts.contact);
+                (self.nearest_pose(c, Some(i)), duty, mixed)
+            })
+            .collect();
         let weights: Vec<f64> = self.clips.iter().map(|c| c.frames as f64).collect();
         let total: f64 = weights.iter().sum();
-        let avg = |f: &dyn Fn(&Movement) -> f64| parts.iter().zip(&weights).map(|(m, w)| f(m) * w).sum::<f64>() / total;
-        let avg_opt = |f: &dyn Fn(&Movement) -> Option<f64>| {
+        let avg_opt = |f: &dyn Fn(&(f64, Option<f64>, Option<f64>)) -> Option<f64>| {
             let v: Vec<(f64, f64)> = parts.iter().zip(&weights).filter_map(|(m, w)| f(m).map(|x| (x, *w))).collect();
             if v.is_empty() {
                 None
@@ -361,10 +358,10 @@ impl<'a> Reference<'a> {
             energy: self.energy,
             energy_ratio: 1.0,
             energy_ratio_range: (ratio(energies.iter().copied().fold(f64::INFINITY, f64::min)), ratio(energies.iter().copied().fold(f64::NEG_INFINITY, f64::max))),
-            nearest_pose: avg(&|m| m.nearest_pose),
+            nearest_pose: parts.iter().zip(&weights).map(|(p, w)| p.0 * w).sum::<f64>() / total,
             calibrated_coverage: self.coverage_leave_one_out(),
-            duty_factor: avg_opt(&|m| m.duty_factor),
-            mixed_contact: avg_opt(&|m| m.mixed_contact),
+            duty_factor: avg_opt(&|p| p.1),
+            mixed_contact: avg_opt(&|p| p.2),
         })
     }
 
