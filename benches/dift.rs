@@ -26,8 +26,8 @@ use menagerie::dift::{self, DiftOptions};
 use menagerie::document::AnyTopSection;
 use menagerie::motion::Motion;
 use menagerie::repr::anytop::AnyTopOptions;
-use menagerie::skeleton::Skeleton;
 use menagerie::rng::SplitMix64;
+use menagerie::skeleton::Skeleton;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -90,7 +90,8 @@ fn extract_all(model: &Frozen, s: &Skeleton, m: &Motion, name: &str) -> anyhow::
     let (mut per_joint, mut shifted_all) = (Vec::new(), Vec::new());
     let started = Instant::now();
     for &(t, layer) in &SETTINGS {
-        let extract = |shift| dift::extract(&model.model, &schedule, &cond, &prepared.features, &DiftOptions { t, layer, draws: DRAWS, seed: 0, shift }, &Device::Cpu);
+        let extract =
+            |shift| dift::extract(&model.model, &schedule, &cond, &prepared.features, &DiftOptions { t, layer, draws: DRAWS, seed: 0, shift }, &Device::Cpu);
         let (fixed, shifted) = (extract(false)?, extract(true)?);
         per_joint.push([fixed.per_joint(), dift::centred(fixed.per_joint())]);
         shifted_all.push(shifted);
@@ -145,8 +146,10 @@ fn main() {
         for (kind, s, m, truth) in &targets {
             let Ok(tgt) = extract_all(&model, s, m, &clip.name) else { continue };
             let Some(rest) = facing_rest(s, m) else { continue };
-            let mut sims: Vec<Vec<Vec<f64>>> =
-                (0..SETTINGS.len()).flat_map(|k| (0..2).map(move |v| (k, v))).map(|(k, v)| cosine_matrix(&tgt.per_joint[k][v], &reference.per_joint[k][v])).collect();
+            let mut sims: Vec<Vec<Vec<f64>>> = (0..SETTINGS.len())
+                .flat_map(|k| (0..2).map(move |v| (k, v)))
+                .map(|(k, v)| cosine_matrix(&tgt.per_joint[k][v], &reference.per_joint[k][v]))
+                .collect();
             sims.push(cosine_matrix(&eval::name_descriptors(s).expect("name table"), &ref_names));
             sims.push(eval::distance_similarity(&eval::geometry_descriptors(&rest), &eval::geometry_descriptors(&ref_rest)));
             let row = joints.entry((clip.set.to_string(), kind)).or_insert_with(|| vec![Accuracy::default(); methods.len()]);

@@ -14,11 +14,11 @@
 //! MENAGERIE_EDIT_QUICK=1 runs only DDIM 20 and our method (~2 minutes instead of ~25).
 use candle_core::Device;
 use menagerie::cli::load::read_skeleton;
-use menagerie::repr::smooth::{lambda_for_cutoff, smooth_features};
-use menagerie::diffusion::edit::{boundary_jumps, jump_distribution, jump_distribution_of, sample_edit, seam_jump, KeepMask};
 use menagerie::diffusion::condition::SkeletonCondition;
+use menagerie::diffusion::edit::{boundary_jumps, jump_distribution, jump_distribution_of, sample_edit, seam_jump, KeepMask};
 use menagerie::diffusion::sample::{sample, SampleOptions};
 use menagerie::diffusion::{checkpoint, Sampler, Schedule};
+use menagerie::repr::smooth::{lambda_for_cutoff, smooth_features};
 use menagerie::repr::Features;
 use std::path::PathBuf;
 
@@ -63,7 +63,13 @@ fn main() {
     };
     let zeros = Features { frames, joints: j, dims: 13, data: stats.mean.iter().copied().cycle().take(frames * j * 13).collect() };
 
-    println!("{} ({frames} frames, {j} joints), kept 0..{quarter} and {}..{frames}; model {} (step {})", clip.display(), frames - quarter, model_dir.display(), loaded.info.step);
+    println!(
+        "{} ({frames} frames, {j} joints), kept 0..{quarter} and {}..{frames}; model {} (step {})",
+        clip.display(),
+        frames - quarter,
+        model_dir.display(),
+        loaded.info.step
+    );
     println!("reference clip: boundary jumps median {:.4}, p95 {:.4}, max {:.4} (BVH units/frame)", data.median, data.p95, data.max);
     println!();
     println!("| method | sampler | seams median | seams max | seams <= data p95 | inside generated median | inside p95 | seconds |");
@@ -71,8 +77,7 @@ fn main() {
     let n = 8;
     // MENAGERIE_EDIT_QUICK=1: DDIM and our method only (the DDPM rows take ~20 minutes).
     let quick = std::env::var_os("MENAGERIE_EDIT_QUICK").is_some();
-    let samplers: &[(Sampler, usize)] =
-        if quick { &[(Sampler::Ddim, 20)] } else { &[(Sampler::Ddim, 20), (Sampler::Ddpm, 100)] };
+    let samplers: &[(Sampler, usize)] = if quick { &[(Sampler::Ddim, 20)] } else { &[(Sampler::Ddim, 20), (Sampler::Ddpm, 100)] };
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     for &(sampler, steps) in samplers {
         let opts = SampleOptions { samples: n, frames, steps, sampler, seed: 1 };

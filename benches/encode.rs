@@ -28,7 +28,6 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-
 struct Clip {
     bytes: Vec<u8>,
     skeleton: Skeleton,

@@ -26,10 +26,10 @@ use menagerie::metrics::Clip as MetricClip;
 use menagerie::motion::Motion;
 use menagerie::repr::anytop::{AnyTopOptions, Placement, RestSource};
 use menagerie::repr::Features;
+use menagerie::rng::SplitMix64;
 use menagerie::sata::checkpoint::{self, Frozen};
 use menagerie::sata::infer::{Latents, Prepared};
 use menagerie::skeleton::Skeleton;
-use menagerie::rng::SplitMix64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -69,7 +69,14 @@ fn sets() -> Vec<(String, Vec<Clip>)> {
     let mut out = Vec::new();
     match std::env::var_os("MENAGERIE_ZOO").map(PathBuf::from) {
         Some(zoo) => {
-            let mut seen: Vec<PathBuf> = std::fs::read_dir(&zoo).into_iter().flatten().flatten().map(|e| e.path()).filter(|p| p.to_string_lossy().ends_with("_v0")).map(|p| p.join("walk_stop_walk_0.bvh")).collect();
+            let mut seen: Vec<PathBuf> = std::fs::read_dir(&zoo)
+                .into_iter()
+                .flatten()
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| p.to_string_lossy().ends_with("_v0"))
+                .map(|p| p.join("walk_stop_walk_0.bvh"))
+                .collect();
             seen.sort();
             out.push(("zoo: held-out clips, seen skeletons".to_string(), seen.iter().filter_map(|p| read(p)).collect::<Vec<_>>()));
             out.push(("zoo: unseen skeleton (dragon_v7)".to_string(), common::bvh_files(&zoo.join("dragon_v7")).iter().filter_map(|p| read(p)).collect()));
@@ -116,7 +123,8 @@ fn encode(clip: &Clip, model: Option<&Frozen>, device: &Device) -> Option<Encode
             Some(known) => (known.section.clone(), known.fit(&clip.skeleton)),
             None => match &clip.rest {
                 Some(rest) => {
-                    let options = AnyTopOptions { rest_source: RestSource::Explicit { file: format!("{} (augmented rest)", clip.name) }, ..AnyTopOptions::default() };
+                    let options =
+                        AnyTopOptions { rest_source: RestSource::Explicit { file: format!("{} (augmented rest)", clip.name) }, ..AnyTopOptions::default() };
                     (AnyTopSection::new(&clip.skeleton, rest, &options)?, clip.skeleton.clone())
                 }
                 None => (AnyTopSection::of_clip(&clip.skeleton, &clip.motion, &clip.name)?, clip.skeleton.clone()),
@@ -180,7 +188,16 @@ impl Mean {
 
     fn row(&self, label: &str) -> String {
         let n = self.n.max(1) as f64;
-        format!("| {label} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.3} |", self.n, self.jr / n, self.rt / n, self.jp / n, self.fs / n, self.gp / n, self.san / n)
+        format!(
+            "| {label} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.3} |",
+            self.n,
+            self.jr / n,
+            self.rt / n,
+            self.jp / n,
+            self.fs / n,
+            self.gp / n,
+            self.san / n
+        )
     }
 }
 
@@ -188,7 +205,8 @@ impl Mean {
 fn distance(a: &Latents, b: &Latents) -> f64 {
     let n = a.frames.min(b.frames);
     let d = a.dims;
-    (0..n).map(|f| a.data[f * d..(f + 1) * d].iter().zip(&b.data[f * d..(f + 1) * d]).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt()).sum::<f64>() / n.max(1) as f64
+    (0..n).map(|f| a.data[f * d..(f + 1) * d].iter().zip(&b.data[f * d..(f + 1) * d]).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt()).sum::<f64>()
+        / n.max(1) as f64
 }
 
 /// The first two frames of the clip `model` took `clip`'s rest pose from, when it knows the
@@ -199,7 +217,12 @@ fn trained_rest(model: &Frozen, clip: &Clip) -> Option<Clip> {
     let (RestSource::TPose { file } | RestSource::FirstClip { file } | RestSource::Explicit { file }) = &known.section.rig.rest_source else { return None };
     let parsed = bvh::read_path(Path::new(file)).ok()?;
     let rest = Motion::from_bvh(&parsed, &Skeleton::from_bvh(&parsed)).first_frames(2);
-    (rest.joints == clip.skeleton.len()).then(|| Clip { name: clip.name.clone(), skeleton: known.fit(&clip.skeleton), motion: clip.motion.clone(), rest: Some(rest) })
+    (rest.joints == clip.skeleton.len()).then(|| Clip {
+        name: clip.name.clone(),
+        skeleton: known.fit(&clip.skeleton),
+        motion: clip.motion.clone(),
+        rest: Some(rest),
+    })
 }
 
 /// The clip's rest frames, when it has them, are augmented along with it (see `Clip::rest`).
@@ -285,7 +308,13 @@ fn main() {
             transfer_rows.push(retarget.row(&format!("{model_name} / {set_name} / SATA")));
             transfer_rows.push(retarget_base.row(&format!("{model_name} / {set_name} / variant's mean pose")));
             let t = total.max(1) as f64;
-            distance_rows.push(format!("| {model_name} / {set_name} | {total} | {:.3} | {:.3} | {:.2} | {:.0}% |", same / t, other / t, (same / t) / (other / t).max(1e-12), 100.0 * nearest as f64 / t));
+            distance_rows.push(format!(
+                "| {model_name} / {set_name} | {total} | {:.3} | {:.3} | {:.2} | {:.0}% |",
+                same / t,
+                other / t,
+                (same / t) / (other / t).max(1e-12),
+                100.0 * nearest as f64 / t
+            ));
         }
     }
     println!("\n## Retargeting onto skel-aug variants (ground truth: the variant's own motion)\n");

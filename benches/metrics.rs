@@ -20,8 +20,8 @@ use menagerie::metrics::generation::{generation_metrics, GenerationOptions, Poin
 use menagerie::metrics::Clip;
 use menagerie::motion::Motion;
 use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig};
-use menagerie::skeleton::{roles, Skeleton};
 use menagerie::rng::SplitMix64;
+use menagerie::skeleton::{roles, Skeleton};
 use menagerie::synth::creature;
 use std::hint::black_box;
 use std::path::Path;
@@ -57,10 +57,7 @@ fn point_clip(skeleton: &Skeleton, motion: &Motion) -> PointClip {
 
 fn main() {
     println!("generation metrics: 20 samples x 120 frames vs 10 GT clips x 100 frames; median of {RUNS} runs, {} threads", rayon::current_num_threads());
-    println!(
-        "{:<12} {:>7} {:>12} {:>14} {:>10} {:>10} {:>10}",
-        "creature", "joints", "median ms", "1-thread ms", "coverage", "local", "global"
-    );
+    println!("{:<12} {:>7} {:>12} {:>14} {:>10} {:>10} {:>10}", "creature", "joints", "median ms", "1-thread ms", "coverage", "local", "global");
     let single = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     for name in ["biped", "quadruped", "spider", "centipede", "dragon"] {
         let Some((skeleton, motion)) = creature(name, 1) else { continue };

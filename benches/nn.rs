@@ -23,8 +23,8 @@ use candle_nn::VarMap;
 use glam::DVec3;
 use menagerie::nn::{batch_from, seeded_var_builder, BatchItem, Denoiser, DenoiserConfig};
 use menagerie::repr::Features;
-use menagerie::skeleton::{topology, Joint, Skeleton};
 use menagerie::rng::SplitMix64;
+use menagerie::skeleton::{topology, Joint, Skeleton};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -103,11 +103,8 @@ fn main() {
     }
     println!();
 
-    let presets: Vec<String> = std::env::var("NN_BENCH_PRESETS")
-        .unwrap_or_else(|_| "tiny,small,paper".to_string())
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
+    let presets: Vec<String> =
+        std::env::var("NN_BENCH_PRESETS").unwrap_or_else(|_| "tiny,small,paper".to_string()).split(',').map(|s| s.trim().to_string()).collect();
     let dev = Device::Cpu;
     let frames = 40usize;
     println!("Batches: `8 x 25..60`: 8 skeletons with 25, 30, .. 60 joints (padded to 60); `4 x 25`: one 25-joint");

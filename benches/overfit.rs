@@ -28,7 +28,14 @@ fn run(cmd: &mut Command) -> Vec<u8> {
 }
 
 fn coverage(clip: &Path, samples: &Path, threshold: f64) -> f64 {
-    let json = run(Command::new(env!("CARGO_BIN_EXE_mo-metrics")).args(["generation", "--gt"]).arg(clip).arg("--gen").arg(samples).arg("--skeleton").arg(clip).args(["--threshold", &threshold.to_string()]));
+    let json = run(Command::new(env!("CARGO_BIN_EXE_mo-metrics"))
+        .args(["generation", "--gt"])
+        .arg(clip)
+        .arg("--gen")
+        .arg(samples)
+        .arg("--skeleton")
+        .arg(clip)
+        .args(["--threshold", &threshold.to_string()]));
     let v: serde_json::Value = serde_json::from_slice(&json).expect("mo-metrics prints JSON");
     v["report"]["coverage"]["mean"].as_f64().expect("a coverage value")
 }

@@ -68,7 +68,14 @@ fn demo() -> Option<Case> {
 fn synthetic() -> Case {
     let (source_skeleton, source) = menagerie::synth::creature("biped", 1).unwrap();
     let (target, example) = menagerie::synth::creature("quadruped", 1).unwrap();
-    let pairs = [("mixamorig:LeftUpLeg", "Bip01_L_Thigh"), ("mixamorig:LeftLeg", "Bip01_L_Calf"), ("mixamorig:LeftFoot", "Bip01_L_Foot"), ("mixamorig:RightUpLeg", "Bip01_R_Thigh"), ("mixamorig:RightLeg", "Bip01_R_Calf"), ("mixamorig:RightFoot", "Bip01_R_Foot")];
+    let pairs = [
+        ("mixamorig:LeftUpLeg", "Bip01_L_Thigh"),
+        ("mixamorig:LeftLeg", "Bip01_L_Calf"),
+        ("mixamorig:LeftFoot", "Bip01_L_Foot"),
+        ("mixamorig:RightUpLeg", "Bip01_R_Thigh"),
+        ("mixamorig:RightLeg", "Bip01_R_Calf"),
+        ("mixamorig:RightFoot", "Bip01_R_Foot"),
+    ];
     let map = pairs.iter().map(|(s, t)| (source_skeleton.index_of(s).unwrap(), target.index_of(t).unwrap())).collect();
     Case { source: source.first_frames(79), source_skeleton, example: example.first_frames(61), target, map }
 }
@@ -135,7 +142,14 @@ fn main() {
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let ref_settings = Settings { alpha: 0.9, ..Settings::default() };
     let paper = Settings::default();
-    println!("{name}: source {} frames x {} joints, example {} frames x {} joints, {} bound bones; {RUNS} runs, median ms", case.source.frames, case.source.joints, case.example.frames, case.example.joints, case.map.len());
+    println!(
+        "{name}: source {} frames x {} joints, example {} frames x {} joints, {} bound bones; {RUNS} runs, median ms",
+        case.source.frames,
+        case.source.joints,
+        case.example.frames,
+        case.example.joints,
+        case.map.len()
+    );
     println!();
     println!("| case | source frames | example clips (frames) | levels | 1 thread ms | 1 thread on-CPU ms | {threads} threads ms | frames/s ({threads} thr) |");
     println!("|---|---:|---:|---|---:|---:|---:|---:|");
@@ -158,7 +172,12 @@ fn main() {
         let one = time(&case, &source, &examples, settings, 1);
         let cpu = cpu_time(&case, &source, &examples, settings).map(|c| format!("{c:.2}")).unwrap_or_else(|| "-".into());
         let all = time(&case, &source, &examples, settings, threads);
-        println!("| {label} | {} | {clips} ({}) | {levels} | {one:.2} | {cpu} | {all:.2} | {:.0} |", source.frames, clips * case.example.frames, source.frames as f64 / all * 1e3);
+        println!(
+            "| {label} | {} | {clips} ({}) | {levels} | {one:.2} | {cpu} | {all:.2} | {:.0} |",
+            source.frames,
+            clips * case.example.frames,
+            source.frames as f64 / all * 1e3
+        );
     }
     println!();
     println!("One run's own timings ({threads} threads, from the report), ms:");
@@ -174,7 +193,8 @@ fn main() {
 /// How far our demo output is from the reference's output BVHs.
 fn compare_with_reference(case: &Case) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/reference-outputs");
-    let files = [("default", "m2m_flamingo_walk_to_monkey_seed0_alpha0.9.bvh", false), ("copy mode", "m2m_flamingo_walk_to_monkey_seed0_alpha0.9_copymode.bvh", true)];
+    let files =
+        [("default", "m2m_flamingo_walk_to_monkey_seed0_alpha0.9.bvh", false), ("copy mode", "m2m_flamingo_walk_to_monkey_seed0_alpha0.9_copymode.bvh", true)];
     if !dir.is_dir() {
         return;
     }
@@ -199,7 +219,8 @@ fn compare_with_reference(case: &Case) {
         let errors: Vec<(f64, Motion)> = (0..5)
             .map(|seed| {
                 let settings = Settings { alpha: 0.9, copy_bound: copy, seed, sample_choices: choices, ..Settings::default() };
-                let ours = retarget(&case.source, &case.source_skeleton, std::slice::from_ref(&case.example), &case.target, &case.map, &settings).unwrap().motion;
+                let ours =
+                    retarget(&case.source, &case.source_skeleton, std::slice::from_ref(&case.example), &case.target, &case.map, &settings).unwrap().motion;
                 (mean_error(&ours, &reference, &case.target), ours)
             })
             .collect();
@@ -210,7 +231,10 @@ fn compare_with_reference(case: &Case) {
         let baseline = mean_error(&looped, &reference, &case.target);
         let (ry, oy) = (root_y(&reference), root_y(ours));
         let diversity = errors[1..].iter().map(|e| mean_error(&e.1, ours, &case.target)).sum::<f64>() / 4.0;
-        println!("| {mode} | {} | {} | {:.2}..{:.2} | {:.2}..{:.2} | {:.3} | {:.3} | {:.2} | {:.3} |", reference.frames, ours.frames, ry.0, ry.1, oy.0, oy.1, errors[0].0, mean5, baseline, diversity);
+        println!(
+            "| {mode} | {} | {} | {:.2}..{:.2} | {:.2}..{:.2} | {:.3} | {:.3} | {:.2} | {:.3} |",
+            reference.frames, ours.frames, ry.0, ry.1, oy.0, oy.1, errors[0].0, mean5, baseline, diversity
+        );
     }
 }
 

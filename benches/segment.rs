@@ -27,11 +27,11 @@ use menagerie::cli::mo_segment::{dift_features, raw_features, segment_input, win
 use menagerie::diffusion::checkpoint;
 use menagerie::dift::DiftOptions;
 use menagerie::motion::Motion;
+use menagerie::rng::SplitMix64;
 use menagerie::segment::{boundaries, boundary_errors, SegmentOptions};
 use menagerie::skeleton::Skeleton;
-use menagerie::synth::{actions, training_clip, Action};
-use menagerie::rng::SplitMix64;
 use menagerie::synth::creature_names;
+use menagerie::synth::{actions, training_clip, Action};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -206,8 +206,7 @@ fn main() {
     let model = checkpoint::frozen_default(&candle_core::Device::Cpu).expect("the built-in model");
     let dift = |input: &Input| dift_features(&model, input, &DiftOptions::TEMPORAL);
     // DIFT runs the denoiser per clip: only the main window settings for it.
-    let providers: Vec<(&str, Provider, &[usize])> =
-        vec![("raw", &raw_features, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]), ("dift", &dift, &[0, 1, 4, 6])];
+    let providers: Vec<(&str, Provider, &[usize])> = vec![("raw", &raw_features, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]), ("dift", &dift, &[0, 1, 4, 6])];
     let configs = vec![
         config("single frames k3 pca8 min10", 3, 8, 0.0, 10, false, true),
         config("window 0.5s k3 pca8 min10", 3, 8, 0.5, 10, false, true),

@@ -60,11 +60,7 @@ fn synthetic_bvh(total: usize, frames: usize) -> String {
                 },
                 parent: parents[j],
                 offset: if j == 0 { [0.0, 60.0, 0.0] } else { [4.0 * a.cos(), 3.0 + (j % 4) as f64, 4.0 * a.sin()] },
-                channels: if j == 0 {
-                    vec![Channel::Xposition, Channel::Yposition, Channel::Zposition, rot[0], rot[1], rot[2]]
-                } else {
-                    rot.to_vec()
-                },
+                channels: if j == 0 { vec![Channel::Xposition, Channel::Yposition, Channel::Zposition, rot[0], rot[1], rot[2]] } else { rot.to_vec() },
                 end_sites: if has_child[j] { Vec::new() } else { vec![[0.0, 2.0, 0.0]] },
             }
         })
@@ -142,10 +138,8 @@ fn time_it<R>(reps: usize, mut f: impl FnMut() -> R) -> (f64, f64) {
 
 fn main() {
     let reps: usize = std::env::args().skip(1).find_map(|a| a.parse().ok()).unwrap_or(60);
-    let mut cases: Vec<(String, Vec<u8>)> = vec![
-        ("synthetic 143 joints".into(), synthetic_bvh(143, 61).into_bytes()),
-        ("synthetic 143 joints".into(), synthetic_bvh(143, 600).into_bytes()),
-    ];
+    let mut cases: Vec<(String, Vec<u8>)> =
+        vec![("synthetic 143 joints".into(), synthetic_bvh(143, 61).into_bytes()), ("synthetic 143 joints".into(), synthetic_bvh(143, 600).into_bytes())];
     let monkey = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bvh/truebones_motion2motion/Monkey/__Walk.bvh");
     match std::fs::read(&monkey) {
         Ok(bytes) => cases.push(("Truebones Monkey __Walk".into(), bytes)),
@@ -154,9 +148,7 @@ fn main() {
 
     println!("skeleton document build: parse + Skeleton + Motion + SkeletonDocument::build + serde_json::to_string");
     println!("{reps} repetitions after 3 warm-up runs; times in ms (median / min)\n");
-    println!(
-        "| case | joints | frames | BVH KiB | JSON KiB | total median | total min | parse | skeleton+motion | build | to_string |"
-    );
+    println!("| case | joints | frames | BVH KiB | JSON KiB | total median | total min | parse | skeleton+motion | build | to_string |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, bytes) in &cases {
         let mut warm = Times::default();

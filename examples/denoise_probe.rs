@@ -41,7 +41,8 @@ fn main() -> anyhow::Result<()> {
     let device = Device::Cpu;
     let loaded = checkpoint::load(std::path::Path::new(&args[0]), &device)?;
     let files = expand_inputs(&args[1..].iter().map(Into::into).collect::<Vec<_>>())?;
-    let clips: Vec<RawClip> = load_motions(&files, &LoadOptions::default())?.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
+    let clips: Vec<RawClip> =
+        load_motions(&files, &LoadOptions::default())?.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
     let names = NameTable::builtin()?;
     let (set, _) = TrainSet::build(clips, names, loaded.info.dmax, &Augmentation::none())?;
     let schedule = Schedule::cosine(loaded.info.schedule_steps);
@@ -58,7 +59,8 @@ fn main() -> anyhow::Result<()> {
             let (a, b) = schedule.noise_coefficients(t);
             let noise = menagerie::rng::gaussian(&mut rng, clean.data.len());
             let noisy = Features { data: clean.data.iter().zip(&noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() };
-            let item = BatchItem { features: &noisy, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 };
+            let item =
+                BatchItem { features: &noisy, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 };
             let batch = batch_from(&[item], &[t as u32], &device)?;
             let pred = loaded.model.forward(&batch)?;
             let frames = clean.frames;

@@ -94,13 +94,7 @@ impl Binding {
             for i in 0..map.len() {
                 let key = |k: usize| if pick == 0 { map[k].0 } else { map[k].1 };
                 if let Some(first) = (0..i).find(|&k| key(k) == key(i)) {
-                    return Err(BindingError::Duplicate {
-                        file: file.to_string(),
-                        first,
-                        second: i,
-                        side,
-                        joint: skeleton.joints[key(i)].name.clone(),
-                    });
+                    return Err(BindingError::Duplicate { file: file.to_string(), first, second: i, side, joint: skeleton.joints[key(i)].name.clone() });
                 }
             }
         }

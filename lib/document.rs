@@ -7,8 +7,8 @@
 //! Later versions add optional fields (feature statistics, the rest-pose feature row);
 //! readers ignore fields they do not know.
 
-use crate::bvh::Channel;
 use crate::bvh::Bvh;
+use crate::bvh::Channel;
 use crate::motion::Motion;
 use crate::repr::anytop::{AnyTopError, AnyTopOptions, AnyTopRig, AnyTopStats, RestSource, FEATURE_DIMS};
 use crate::skeleton::names::{self, Side};
@@ -160,12 +160,7 @@ impl MotionInfo {
         }
         let first = Motion::from_bvh_frames(bvh, skeleton, 0..1).forward_kinematics(skeleton);
         let (lo, hi) = first.positions.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
-        Some(MotionInfo {
-            frames: bvh.frames,
-            fps: 1.0 / bvh.frame_time,
-            duration_s: bvh.frames as f64 * bvh.frame_time,
-            first_frame_height: hi - lo,
-        })
+        Some(MotionInfo { frames: bvh.frames, fps: 1.0 / bvh.frame_time, duration_s: bvh.frames as f64 * bvh.frame_time, first_frame_height: hi - lo })
     }
 }
 

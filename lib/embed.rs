@@ -112,8 +112,7 @@ impl NameTable {
         }
         let header_len = r.u32()? as usize;
         let header_at = r.at;
-        let header: Header = serde_json::from_slice(r.take(header_len)?)
-            .map_err(|e| EmbedError::Header(format!("{e} (JSON at byte {header_at})")))?;
+        let header: Header = serde_json::from_slice(r.take(header_len)?).map_err(|e| EmbedError::Header(format!("{e} (JSON at byte {header_at})")))?;
         if header.format_version != FORMAT_VERSION {
             return Err(EmbedError::Header(format!("format_version {} (expected {FORMAT_VERSION})", header.format_version)));
         }

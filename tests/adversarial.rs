@@ -77,14 +77,19 @@ fn judge(c: &Case, out: &Output) -> Option<String> {
         }
         if let Some(dir) = p.parent() {
             if let Ok(rd) = std::fs::read_dir(dir) {
-                let temps: Vec<String> = rd.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.contains(".tmp")).collect();
+                let temps: Vec<String> =
+                    rd.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.contains(".tmp")).collect();
                 if !temps.is_empty() {
                     wrong.push(format!("temporary files left: {temps:?}"));
                 }
             }
         }
     }
-    if wrong.is_empty() { None } else { Some(format!("{} ({} {:?}): {}: {}", c.name, c.tool, c.args, wrong.join(", "), err.trim_end())) }
+    if wrong.is_empty() {
+        None
+    } else {
+        Some(format!("{} ({} {:?}): {}: {}", c.name, c.tool, c.args, wrong.join(", "), err.trim_end()))
+    }
 }
 
 fn check_all(cases: Vec<Case>) {
@@ -237,13 +242,8 @@ fn invalid_inputs_are_refused() {
     let cases = vec![
         case("1e300 in a BVH", "mo-encode", &[s(&huge), "-q", "-o", o], &["huge.bvh", "too large"]).absent(&[&out]),
         case("1e300 in a BVH, m2m", "mo-encode", &[s(&huge), "-q", "--repr", "m2m", "-o", o], &["huge.bvh", "too large"]).absent(&[&out]),
-        case(
-            "placement too large",
-            "mo-encode",
-            &[s(&encoded), "--decode", "--skeleton", b, "--placement", s(&placement), "-o", s(&bvh_out)],
-            &["non-finite"],
-        )
-        .absent(&[&bvh_out]),
+        case("placement too large", "mo-encode", &[s(&encoded), "--decode", "--skeleton", b, "--placement", s(&placement), "-o", s(&bvh_out)], &["non-finite"])
+            .absent(&[&bvh_out]),
         case("joint_count", "mo-encode", &[s(&encoded), "--decode", "--skeleton", s(&wrong_count), "-o", s(&bvh_out)], &["count.json", "joint_count"])
             .absent(&[&bvh_out]),
         case("9 Xrotation channels", "mo-encode", &[s(&encoded), "--decode", "--skeleton", s(&dup_channels), "-o", s(&bvh_out)], &["dup.json", "twice"])
@@ -255,8 +255,7 @@ fn invalid_inputs_are_refused() {
         case("[0, J, 13]", "mo-render", &[s(&zero), "--skeleton", b, "--sheet", s(&sheet)], &["zero.npy", "no frames"]).absent(&[&sheet]),
         case("schedule_steps 0", "mo-sample", &[b, "--model", s(&model), "--frames", "4", "-o", o], &["schedule_steps"]).absent(&[&out]),
         case("schedule_steps 0", "mo-dift", &[b, "--model", s(&model), "-o", o], &["schedule_steps"]).absent(&[&out]),
-        case("segment to 1e9", "mo-render", &[b, "--frame-labels", s(&far_labels), "--sheet", s(&sheet)], &["labels.json", "1000000000"])
-            .absent(&[&sheet]),
+        case("segment to 1e9", "mo-render", &[b, "--frame-labels", s(&far_labels), "--sheet", s(&sheet)], &["labels.json", "1000000000"]).absent(&[&sheet]),
         case("empty --rest-pose", "skel-info", &[s(&good), "--rest-pose", s(&empty), "-o", o], &["empty.bvh", "no frames"]).absent(&[&out]),
         // Messages.
         case("parent 999 said once", "mo-sample", &[s(&bad_parent), "-o", o], &["parent.json", "parent 999"]).absent(&[&out]),
@@ -268,8 +267,13 @@ fn invalid_inputs_are_refused() {
             &["placement-syntax.json", "line 2", "column"],
         )
         .absent(&[&bvh_out]),
-        case("JSON syntax: line and column", "mo-encode", &[s(&encoded), "--decode", "--skeleton", s(&syntax), "-o", s(&bvh_out)], &["syntax.json", "line 3", "column"])
-            .absent(&[&bvh_out]),
+        case(
+            "JSON syntax: line and column",
+            "mo-encode",
+            &[s(&encoded), "--decode", "--skeleton", s(&syntax), "-o", s(&bvh_out)],
+            &["syntax.json", "line 3", "column"],
+        )
+        .absent(&[&bvh_out]),
     ];
     check_all(cases);
     // A repeated message is the bug, whatever else it says.
@@ -367,7 +371,11 @@ fn a_symlink_given_to_o_stays_a_link() {
         let is_link = std::fs::symlink_metadata(&link).map(|m| m.file_type().is_symlink()).unwrap_or(false);
         let written = std::fs::metadata(&target).map(|m| m.len() > 0).unwrap_or(false);
         if !(out.status.success() && is_link && written) {
-            failures.push(format!("{tool}: exit {:?}, still a link: {is_link}, target written: {written}: {}", out.status.code(), String::from_utf8_lossy(&out.stderr).trim_end()));
+            failures.push(format!(
+                "{tool}: exit {:?}, still a link: {is_link}, target written: {written}: {}",
+                out.status.code(),
+                String::from_utf8_lossy(&out.stderr).trim_end()
+            ));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -413,7 +421,12 @@ fn devices_given_to_o_are_written_in_place() {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let out = run(tool, &args, None);
         if !(out.status.success() && is_char_device(&null)) {
-            failures.push(format!("{tool} -o null-device: exit {:?}, still a device: {}: {}", out.status.code(), is_char_device(&null), String::from_utf8_lossy(&out.stderr).trim_end()));
+            failures.push(format!(
+                "{tool} -o null-device: exit {:?}, still a device: {}: {}",
+                out.status.code(),
+                is_char_device(&null),
+                String::from_utf8_lossy(&out.stderr).trim_end()
+            ));
         }
     }
     for (tool, args) in writers(&full, &dir) {
@@ -427,7 +440,8 @@ fn devices_given_to_o_are_written_in_place() {
             failures.push(format!("{tool}: the full device was replaced"));
         }
     }
-    let temps: Vec<String> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.contains(".tmp")).collect();
+    let temps: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.contains(".tmp")).collect();
     assert!(temps.is_empty(), "temporary files left: {temps:?}");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     let _ = std::fs::remove_dir_all(&dir);

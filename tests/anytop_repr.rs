@@ -5,9 +5,7 @@ mod common;
 
 use menagerie::bvh;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{
-    AnyTopOptions, AnyTopRig, AnyTopStats, Facing, IkOptions, Placement, RestSource, DIM_CONTACT, FEATURE_DIMS,
-};
+use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig, AnyTopStats, Facing, IkOptions, Placement, RestSource, DIM_CONTACT, FEATURE_DIMS};
 use menagerie::repr::Features;
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;
@@ -30,10 +28,7 @@ fn load(path: &Path, max_frames: usize) -> Clip {
 
 fn same_hierarchy(a: &Skeleton, b: &Skeleton) -> bool {
     a.len() == b.len()
-        && a.joints
-            .iter()
-            .zip(&b.joints)
-            .all(|(x, y)| x.name == y.name && x.parent == y.parent && x.offset == y.offset && x.channels == y.channels)
+        && a.joints.iter().zip(&b.joints).all(|(x, y)| x.name == y.name && x.parent == y.parent && x.offset == y.offset && x.channels == y.channels)
 }
 
 /// AnyTop's rest-clip rule within a folder: a `*tpos*` file of the same skeleton, else the
@@ -61,11 +56,8 @@ fn rest_for(path: &Path, clip: &Clip) -> (Clip, RestSource) {
 /// Sites), or the rest extent for a flat creature (a snake lying on the ground).
 fn size(clip: &Clip) -> f64 {
     let first = Motion { frames: 1, ..clip.motion.clone() };
-    let first = Motion {
-        rotations: first.rotations[..clip.skeleton.len()].to_vec(),
-        translations: first.translations[..clip.skeleton.len()].to_vec(),
-        ..first
-    };
+    let first =
+        Motion { rotations: first.rotations[..clip.skeleton.len()].to_vec(), translations: first.translations[..clip.skeleton.len()].to_vec(), ..first };
     let w = first.forward_kinematics(&clip.skeleton);
     let mut ys: Vec<f64> = w.positions.iter().map(|p| p.y).collect();
     for (j, joint) in clip.skeleton.joints.iter().enumerate() {
@@ -152,9 +144,8 @@ fn check_file(path: &Path) -> Report {
     let mut report = Report::default();
     let clip = load(path, usize::MAX);
     let (rest, source) = rest_for(path, &clip);
-    let rig =
-        AnyTopRig::new(&clip.skeleton, &rest.motion, &AnyTopOptions { rest_source: source, ..Default::default() })
-            .unwrap_or_else(|e| panic!("{}: {e}", clip.name));
+    let rig = AnyTopRig::new(&clip.skeleton, &rest.motion, &AnyTopOptions { rest_source: source, ..Default::default() })
+        .unwrap_or_else(|e| panic!("{}: {e}", clip.name));
     let skeleton = &clip.skeleton;
     report.files = 1;
     report.lines.push(format!(
@@ -205,9 +196,7 @@ fn check_file(path: &Path) -> Report {
     let ik = rig.decode_ik(skeleton, &enc.features, &enc.placement, &IkOptions::default()).unwrap();
     let ik_err = worst_fk(skeleton, &clip.motion, &ik, frames, scale);
     report.ik.update(ik_err, &clip.name);
-    report.lines.push(format!(
-        "    frames {frames}, size {scale:.3}: positions {pos_err:.2e}, rotations {rot_err:.2e}, re-encode {diff:.2e}, ik {ik_err:.2e}"
-    ));
+    report.lines.push(format!("    frames {frames}, size {scale:.3}: positions {pos_err:.2e}, rotations {rot_err:.2e}, re-encode {diff:.2e}, ik {ik_err:.2e}"));
     report
 }
 
@@ -225,37 +214,13 @@ fn check_all(files: &[PathBuf], label: &str) {
         eprintln!("{l}");
     }
     eprintln!("{label}: {} files; fewer than two frames (zero feature frames): {:?}", report.files, report.short);
-    eprintln!(
-        "{label}: worst recovered positions      {:.3e} of size ({})",
-        report.positions.value, report.positions.file
-    );
-    eprintln!(
-        "{label}: worst decode from rotations    {:.3e} of size ({})",
-        report.rotations.value, report.rotations.file
-    );
-    eprintln!(
-        "{label}: worst re-encode via BVH text   {:.3e} absolute ({})",
-        report.reencode.value, report.reencode.file
-    );
+    eprintln!("{label}: worst recovered positions      {:.3e} of size ({})", report.positions.value, report.positions.file);
+    eprintln!("{label}: worst decode from rotations    {:.3e} of size ({})", report.rotations.value, report.rotations.file);
+    eprintln!("{label}: worst re-encode via BVH text   {:.3e} absolute ({})", report.reencode.value, report.reencode.file);
     eprintln!("{label}: worst decode from positions    {:.3e} of size ({})", report.ik.value, report.ik.file);
-    assert!(
-        report.positions.value < 1e-4,
-        "recovered positions off by {:.3e} ({})",
-        report.positions.value,
-        report.positions.file
-    );
-    assert!(
-        report.rotations.value < 1e-4,
-        "decode from rotations off by {:.3e} ({})",
-        report.rotations.value,
-        report.rotations.file
-    );
-    assert!(
-        report.reencode.value < 1e-5,
-        "re-encoding differs by {:.3e} ({})",
-        report.reencode.value,
-        report.reencode.file
-    );
+    assert!(report.positions.value < 1e-4, "recovered positions off by {:.3e} ({})", report.positions.value, report.positions.file);
+    assert!(report.rotations.value < 1e-4, "decode from rotations off by {:.3e} ({})", report.rotations.value, report.rotations.file);
+    assert!(report.reencode.value < 1e-5, "re-encoding differs by {:.3e} ({})", report.reencode.value, report.reencode.file);
     assert!(report.ik.value < 1e-2, "decode from positions off by {:.3e} ({})", report.ik.value, report.ik.file);
 }
 
@@ -307,11 +272,7 @@ fn check_invariants(path: &Path) -> (String, usize, usize) {
     for t in 0..f.frames {
         let root = f.at(t, 0);
         assert!(root[0] == 0.0 && root[2] == 0.0, "{}: root x/z at frame {t}: {root:?}", clip.name);
-        assert!(
-            root[4] == 0.0 && root[6..9] == [0.0, 1.0, 0.0],
-            "{}: root 6D not a yaw at frame {t}: {root:?}",
-            clip.name
-        );
+        assert!(root[4] == 0.0 && root[6..9] == [0.0, 1.0, 0.0], "{}: root 6D not a yaw at frame {t}: {root:?}", clip.name);
         let c0 = (root[3] as f64).hypot(root[5] as f64);
         assert!((c0 - 1.0).abs() < 1e-6, "{}: root 6D column 0 not unit: {root:?}", clip.name);
         for j in 0..f.joints {
@@ -336,8 +297,7 @@ fn check_invariants(path: &Path) -> (String, usize, usize) {
 #[test]
 fn reference_invariants_hold_on_real_clips() {
     let Some(data) = common::shared_data("reference_invariants_hold_on_real_clips") else { return };
-    let results: Vec<(String, usize, usize)> =
-        common::corpus_bvh_files(&data).par_iter().map(|p| check_invariants(p)).collect();
+    let results: Vec<(String, usize, usize)> = common::corpus_bvh_files(&data).par_iter().map(|p| check_invariants(p)).collect();
     let total: usize = results.iter().map(|r| r.1).sum();
     for (name, c, possible) in &results {
         eprintln!("{name}: {c} contacts of {possible} foot-frames");
@@ -461,21 +421,7 @@ fn statistics_group_as_the_reference() {
     let stats = AnyTopStats::compute([&a, &b]).unwrap();
     let want_std: [[f32; FEATURE_DIMS]; 2] = [
         [1.0, 1.0, 1.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.0, 0.0, 0.0, 1.0],
-        [
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0 / 3.0,
-            1.0,
-            1.0,
-            1.0,
-            0.5,
-        ],
+        [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0, 1.0, 1.0, 0.5],
     ];
     for (j, want) in want_std.iter().enumerate() {
         for (d, want) in want.iter().enumerate() {
@@ -512,10 +458,7 @@ fn generated_like_features_decode_to_finite_motion() {
         *v += ((state >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 0.02;
     }
     let placement = rig.rest_placement();
-    for m in [
-        rig.decode(&clip.skeleton, &f, &placement).unwrap(),
-        rig.decode_ik(&clip.skeleton, &f, &placement, &IkOptions::default()).unwrap(),
-    ] {
+    for m in [rig.decode(&clip.skeleton, &f, &placement).unwrap(), rig.decode_ik(&clip.skeleton, &f, &placement, &IkOptions::default()).unwrap()] {
         assert!(m.rotations.iter().all(|q| q.is_finite()) && m.translations.iter().all(|t| t.is_finite()));
         assert_eq!(m.frames, f.frames);
     }

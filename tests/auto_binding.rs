@@ -64,7 +64,15 @@ fn flamingo_legs_bind_to_monkey_legs_left_to_left() {
     let bvh = data.join("bvh/truebones_motion2motion");
     let (sa, sb, pairs) = bind(&bvh.join("Flamingo/Flamingo_Walk.bvh"), &bvh.join("Monkey/__Walk.bvh"), &AutoOptions::default());
     let leg = |n: &str| ["Thigh", "Calf", "HorseLink", "Foot", "Toe"].iter().any(|w| n.contains(w));
-    let side = |n: &str| if n.contains("_L_") { 'L' } else if n.contains("_R_") { 'R' } else { 'C' };
+    let side = |n: &str| {
+        if n.contains("_L_") {
+            'L'
+        } else if n.contains("_R_") {
+            'R'
+        } else {
+            'C'
+        }
+    };
     let good = report("Flamingo -> Monkey", &sa, &sb, &pairs, |c| {
         let (s, t) = (&sa.joints[c.source].name, &sb.joints[c.target].name);
         // A flamingo leg joint binds to a monkey leg joint of the same side.

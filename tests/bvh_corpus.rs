@@ -11,10 +11,7 @@ fn every_corpus_file_parses_and_round_trips() {
         let text = std::fs::read(&path).unwrap();
         let name = path.display().to_string();
         let a = bvh::parse_bytes(&text, &name).unwrap_or_else(|e| panic!("{e}"));
-        let entries = String::from_utf8_lossy(&text)
-            .lines()
-            .filter(|l| matches!(l.split_whitespace().next(), Some("ROOT") | Some("JOINT")))
-            .count();
+        let entries = String::from_utf8_lossy(&text).lines().filter(|l| matches!(l.split_whitespace().next(), Some("ROOT") | Some("JOINT"))).count();
         assert_eq!(a.joints.len(), entries, "{name}: joint count");
         assert_eq!(a.values.len(), a.frames * a.channel_count(), "{name}");
         assert!(a.frames >= 1, "{name}");

@@ -150,20 +150,8 @@ fn reference_python(test: &str) -> Option<(String, PathBuf)> {
 /// Run `fk_dump.py` on `files` in one Python process.
 fn fk_dump(python: &str, tools: &Path, frames: &str, files: &[PathBuf]) -> Vec<RefFile> {
     let script = manifest().join("tests/tools/fk_dump.py");
-    let out = Command::new(python)
-        .arg(&script)
-        .arg("--bvhfk")
-        .arg(tools)
-        .args(["--frames", frames])
-        .args(files)
-        .output()
-        .expect("run fk_dump.py");
-    assert!(
-        out.status.success(),
-        "fk_dump.py failed ({}): {}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = Command::new(python).arg(&script).arg("--bvhfk").arg(tools).args(["--frames", frames]).args(files).output().expect("run fk_dump.py");
+    assert!(out.status.success(), "fk_dump.py failed ({}): {}", out.status, String::from_utf8_lossy(&out.stderr));
     let dump: RefDump = serde_json::from_slice(&out.stdout).expect("fk_dump.py output is JSON");
     assert_eq!(dump.files.len(), files.len(), "fk_dump.py answered for every file");
     dump.files
@@ -217,14 +205,7 @@ fn handmade_bvh_is_what_it_claims() {
     let parsed = bvh::parse(HANDMADE_BVH, "handmade").unwrap();
     assert_eq!(parsed.joints.len(), 8);
     assert_eq!(parsed.frames, 3);
-    let rot_order = |j: usize| -> String {
-        parsed.joints[j]
-            .channels
-            .iter()
-            .filter(|c| c.is_rotation())
-            .map(|c| ["X", "Y", "Z"][c.axis()])
-            .collect()
-    };
+    let rot_order = |j: usize| -> String { parsed.joints[j].channels.iter().filter(|c| c.is_rotation()).map(|c| ["X", "Y", "Z"][c.axis()]).collect() };
     let orders: Vec<String> = (0..8).map(rot_order).collect();
     for wanted in ["ZXY", "XYZ", "YZX"] {
         assert!(orders.iter().any(|o| o == wanted), "handmade BVH lacks order {wanted}: {orders:?}");
@@ -241,15 +222,11 @@ fn handmade_bvh_is_what_it_claims() {
 #[test]
 fn handmade_fixture_matches_our_fk() {
     let fixture = read_fixture();
-    assert_eq!(
-        fixture.bvh, HANDMADE_BVH,
-        "{FIXTURE} was computed for a different BVH; rerun with MENAGERIE_REGEN_FIXTURES=1 (needs numpy)"
-    );
+    assert_eq!(fixture.bvh, HANDMADE_BVH, "{FIXTURE} was computed for a different BVH; rerun with MENAGERIE_REGEN_FIXTURES=1 (needs numpy)");
     let (skeleton, ours) = our_fk(HANDMADE_BVH.as_bytes(), "handmade");
     assert_eq!(fixture.positions.len(), ours.frames);
     let frames: Vec<usize> = (0..ours.frames).collect();
-    let (err, f, j) =
-        worst_error("handmade", &skeleton, &ours, &fixture.names, &frames, &fixture.positions, fixture.height);
+    let (err, f, j) = worst_error("handmade", &skeleton, &ours, &fixture.names, &frames, &fixture.positions, fixture.height);
     println!("handmade fixture: worst FK error {err:.3e} of height (frame {f}, joint {j})");
     assert!(err <= FIXTURE_TOLERANCE, "handmade: FK error {err:e} of height at frame {f} joint {j}");
     // The fixture really exercises rotations: frames 1 and 2 are far from frame 0.
@@ -329,13 +306,7 @@ fn corpus_fk_matches_bvhfk() {
             failures.push(format!("{name}: {err:e} at frame {f} joint {j} '{}'", r.names[j]));
         }
     }
-    println!(
-        "corpus FK vs bvhfk: {} files, worst relative error {:.3e} ({}), {:.1} s",
-        files.len(),
-        worst.0,
-        worst.1,
-        started.elapsed().as_secs_f64()
-    );
+    println!("corpus FK vs bvhfk: {} files, worst relative error {:.3e} ({}), {:.1} s", files.len(), worst.0, worst.1, started.elapsed().as_secs_f64());
     assert!(failures.is_empty(), "FK disagrees with bvhfk beyond {CORPUS_TOLERANCE:e}:\n{}", failures.join("\n"));
 }
 

@@ -20,8 +20,5 @@ fn man_pages_and_completions_are_fresh() {
             _ => stale.push(rel),
         }
     }
-    assert!(
-        stale.is_empty(),
-        "stale generated files (run `MENAGERIE_BLESS=1 cargo test --test generated_docs`): {stale:?}"
-    );
+    assert!(stale.is_empty(), "stale generated files (run `MENAGERIE_BLESS=1 cargo test --test generated_docs`): {stale:?}");
 }

@@ -4,26 +4,26 @@ mod common;
 
 /// A valid two-joint file, line by line, that the cases below break in one place each.
 const GOOD: &[&str] = &[
-    "HIERARCHY",                                                                    // 1
-    "ROOT Hips",                                                                    // 2
-    "{",                                                                            // 3
-    "\tOFFSET 0 1 0",                                                               // 4
-    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",     // 5
-    "\tJOINT Spine",                                                                // 6
-    "\t{",                                                                          // 7
-    "\t\tOFFSET 0 0.2 0",                                                           // 8
-    "\t\tCHANNELS 3 Zrotation Xrotation Yrotation",                                 // 9
-    "\t\tEnd Site",                                                                 // 10
-    "\t\t{",                                                                        // 11
-    "\t\t\tOFFSET 0 0.3 0",                                                         // 12
-    "\t\t}",                                                                        // 13
-    "\t}",                                                                          // 14
-    "}",                                                                            // 15
-    "MOTION",                                                                       // 16
-    "Frames: 2",                                                                    // 17
-    "Frame Time: 0.0333333",                                                        // 18
-    "0 1 0 0 0 0 1 2 3",                                                            // 19
-    "0 1 0.1 0 0 0 4 5 6",                                                          // 20
+    "HIERARCHY",                                                                // 1
+    "ROOT Hips",                                                                // 2
+    "{",                                                                        // 3
+    "\tOFFSET 0 1 0",                                                           // 4
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", // 5
+    "\tJOINT Spine",                                                            // 6
+    "\t{",                                                                      // 7
+    "\t\tOFFSET 0 0.2 0",                                                       // 8
+    "\t\tCHANNELS 3 Zrotation Xrotation Yrotation",                             // 9
+    "\t\tEnd Site",                                                             // 10
+    "\t\t{",                                                                    // 11
+    "\t\t\tOFFSET 0 0.3 0",                                                     // 12
+    "\t\t}",                                                                    // 13
+    "\t}",                                                                      // 14
+    "}",                                                                        // 15
+    "MOTION",                                                                   // 16
+    "Frames: 2",                                                                // 17
+    "Frame Time: 0.0333333",                                                    // 18
+    "0 1 0 0 0 0 1 2 3",                                                        // 19
+    "0 1 0.1 0 0 0 4 5 6",                                                      // 20
 ];
 
 fn with(line: usize, replacement: &str) -> String {

@@ -120,8 +120,7 @@ fn a_creature_lifted_or_sunk_floats_or_penetrates_by_the_amount() {
     let (_, _, clip) = example("quadruped.bvh");
     let opts = PhysicsOptions::default();
     let base = physics::physics(&clip, &opts).unwrap();
-    let lowest_foot: Vec<f64> =
-        (0..clip.frames).map(|f| clip.feet.iter().map(|&j| clip.at(f, j).y).fold(f64::INFINITY, f64::min)).collect();
+    let lowest_foot: Vec<f64> = (0..clip.frames).map(|f| clip.feet.iter().map(|&j| clip.at(f, j).y).fold(f64::INFINITY, f64::min)).collect();
     let lowest: Vec<f64> = (0..clip.frames).map(|f| clip.frame(f).iter().map(|p| p.y).fold(f64::INFINITY, f64::min)).collect();
     // Lift by a full size: floating = mean(lowest foot + lift - band), nothing penetrates.
     let lift = clip.scale;
@@ -225,10 +224,7 @@ fn physics_on_every_corpus_file() {
     let Some(data) = common::shared_data("physics_on_every_corpus_file") else { return };
     let files = common::corpus_bvh_files(&data);
     let t0 = Instant::now();
-    let clips: Vec<(String, Clip)> = files
-        .par_iter()
-        .map(|p| (p.strip_prefix(&data).unwrap_or(p).display().to_string(), load(p).2))
-        .collect();
+    let clips: Vec<(String, Clip)> = files.par_iter().map(|p| (p.strip_prefix(&data).unwrap_or(p).display().to_string(), load(p).2)).collect();
     let loading = t0.elapsed();
     let frames: usize = clips.iter().map(|(_, c)| c.frames).sum();
     let t1 = Instant::now();

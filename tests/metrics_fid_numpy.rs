@@ -41,10 +41,7 @@ fn python() -> String {
 fn textbook(tag: &str, cases: &[Case]) -> Option<Vec<f64>> {
     let dir = common::tempdir(tag);
     let data = dir.join("sets.json");
-    let doc: Vec<serde_json::Value> = cases
-        .iter()
-        .map(|(r, g, n)| serde_json::json!({ "real": r, "generated": g, "normalise": n }))
-        .collect();
+    let doc: Vec<serde_json::Value> = cases.iter().map(|(r, g, n)| serde_json::json!({ "real": r, "generated": g, "normalise": n })).collect();
     std::fs::write(&data, serde_json::to_vec(&doc).unwrap()).unwrap();
     let script = dir.join("fid.py");
     std::fs::write(&script, TEXTBOOK).unwrap();
@@ -97,11 +94,6 @@ fn fid_matches_numpy_and_scipy() {
     let generated_low = mixed_set(90, 10, 3, 0.5, 4);
     compare(
         "fid_matches_numpy_and_scipy",
-        &[
-            (&real, &generated, false),
-            (&real, &generated, true),
-            (&real_low, &generated_low, false),
-            (&real_low, &generated_low, true),
-        ],
+        &[(&real, &generated, false), (&real, &generated, true), (&real_low, &generated_low, false), (&real_low, &generated_low, true)],
     );
 }

@@ -15,7 +15,7 @@
 //! The worst errors are printed (run with `--nocapture`).
 mod common;
 
-use common::{tempdir, s, ok, load, check_failure};
+use common::{check_failure, load, ok, s, tempdir};
 
 use menagerie::bvh;
 use menagerie::document::SkeletonDocument;
@@ -82,9 +82,7 @@ fn size(skeleton: &Skeleton, motion: &Motion) -> f64 {
 fn worst_position_error(skeleton: &Skeleton, clip: &Motion, decoded: &Motion, shift: usize) -> f64 {
     let n = skeleton.len();
     let (a, b) = (clip.forward_kinematics(skeleton), decoded.forward_kinematics(skeleton));
-    (0..decoded.frames.min(clip.frames - shift) * n)
-        .map(|k| a.positions[k + shift * n].distance(b.positions[k]))
-        .fold(0.0, f64::max)
+    (0..decoded.frames.min(clip.frames - shift) * n).map(|k| a.positions[k + shift * n].distance(b.positions[k])).fold(0.0, f64::max)
 }
 
 fn max_abs_diff(a: &[f32], b: &[f32]) -> f32 {
@@ -113,8 +111,7 @@ fn round_trip(path: &Path, dir: &Path, label: &str) -> RoundTrip {
     static SERIAL: AtomicUsize = AtomicUsize::new(0);
     let serial = SERIAL.fetch_add(1, Ordering::Relaxed);
     let at = |what: &str| dir.join(format!("{serial}.{what}"));
-    let (features_path, doc, place, back, ik_path, again_path) =
-        (at("npy"), at("skel.json"), at("place.json"), at("back.bvh"), at("ik.bvh"), at("again.npy"));
+    let (features_path, doc, place, back, ik_path, again_path) = (at("npy"), at("skel.json"), at("place.json"), at("back.bvh"), at("ik.bvh"), at("again.npy"));
     let enc = run(&[s(path), "--emit-skeleton", s(&doc), "--placement", s(&place), "-o", s(&features_path), "-q"]);
     ok(&enc, &format!("encode {label}"));
     let decode = |from: &str, out: &Path| {
@@ -165,9 +162,7 @@ fn report_and_check(what: &str, trips: &[RoundTrip]) {
             t.shifted
         );
     }
-    let worst = |f: &dyn Fn(&RoundTrip) -> f64| {
-        trips.iter().map(|t| (f(t), t.label.as_str())).fold((0.0, ""), |a, b| if b.0 > a.0 { b } else { a })
-    };
+    let worst = |f: &dyn Fn(&RoundTrip) -> f64| trips.iter().map(|t| (f(t), t.label.as_str())).fold((0.0, ""), |a, b| if b.0 > a.0 { b } else { a });
     let (rot, rot_file) = worst(&|t| t.rotations);
     let (ik, ik_file) = worst(&|t| t.ik);
     let (re, re_file) = worst(&|t| t.reencode.map_or(0.0, f64::from));
@@ -555,9 +550,19 @@ fn bad_input_exits_2_with_one_line_and_no_file() {
             vec![],
             format!("sample 1: {nan_text}"),
         ),
-        ("joint count", write("wide.npy", &npy_of(&wide.shape(), &wide.data)), vec![], format!("the features have {} joints but the skeleton has {}", f.joints + 1, f.joints)),
+        (
+            "joint count",
+            write("wide.npy", &npy_of(&wide.shape(), &wide.data)),
+            vec![],
+            format!("the features have {} joints but the skeleton has {}", f.joints + 1, f.joints),
+        ),
         ("rank 2", write("rank2.npy", &npy_of(&[f.frames, f.joints * 13], &f.data)), vec![], "(rank 2)".into()),
-        ("int dtype", write("int.npy", &raw_npy("<i4", &format!("({}, {}, 13)", f.frames, f.joints), &vec![0u8; f.data.len() * 4])), vec![], "unsupported dtype '<i4'".into()),
+        (
+            "int dtype",
+            write("int.npy", &raw_npy("<i4", &format!("({}, {}, 13)", f.frames, f.joints), &vec![0u8; f.data.len() * 4])),
+            vec![],
+            "unsupported dtype '<i4'".into(),
+        ),
         ("--normalised without statistics", at("f.npy"), vec!["--normalised"], "has no AnyTop statistics".into()),
         ("placement file", at("f.npy"), vec!["--placement", s(&biped)], "not a placement file".into()),
     ];

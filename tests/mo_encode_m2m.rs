@@ -5,7 +5,7 @@
 //! one line and leaves no file behind.
 mod common;
 
-use common::{tempdir, s, ok, load, check_failure};
+use common::{check_failure, load, ok, s, tempdir};
 
 use menagerie::bvh;
 use menagerie::io::npy;
@@ -167,14 +167,7 @@ fn numpy_loads_the_encoded_tensor() {
     let out = std::process::Command::new("python3").arg("-c").arg(&script).output().unwrap();
     ok(&out, "python3");
     let text = String::from_utf8(out.stdout).unwrap();
-    let want = format!(
-        "<f4 ({}, {}, 9) <f4 (2, {}, {}, 9) {} True",
-        f.frames,
-        f.joints,
-        f.frames,
-        f.joints,
-        python_float(f.at(3, 0)[7])
-    );
+    let want = format!("<f4 ({}, {}, 9) <f4 (2, {}, {}, 9) {} True", f.frames, f.joints, f.frames, f.joints, python_float(f.at(3, 0)[7]));
     assert_eq!(text.trim(), want);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -182,7 +175,11 @@ fn numpy_loads_the_encoded_tensor() {
 /// Python's repr of a float32 value widened to float64.
 fn python_float(v: f32) -> String {
     let s = format!("{:?}", v as f64);
-    if s.contains('.') || s.contains('e') { s } else { format!("{s}.0") }
+    if s.contains('.') || s.contains('e') {
+        s
+    } else {
+        format!("{s}.0")
+    }
 }
 
 fn common_python() -> bool {
@@ -249,7 +246,10 @@ fn output_is_byte_identical_for_any_thread_count() {
     std::fs::write(&npy_path, &one).unwrap();
     for threads in ["1", "2"] {
         let pattern = dir.join(format!("t{threads}_{{i}}.bvh"));
-        ok(&common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(spider), s(&npy_path), "-o", s(&pattern), "--threads", threads], None), "decode");
+        ok(
+            &common::run("mo-encode", &["--repr", "m2m", "--decode", "--skeleton", s(spider), s(&npy_path), "-o", s(&pattern), "--threads", threads], None),
+            "decode",
+        );
     }
     for i in 0..6 {
         let a = std::fs::read(dir.join(format!("t1_{i}.bvh"))).unwrap();

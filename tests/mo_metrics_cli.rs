@@ -57,10 +57,8 @@ fn a_motion_against_itself_is_perfect() {
     assert!((motion - 1.0).abs() < 1e-9, "motion ratio of a motion with itself: {motion}");
 
     let quad = example("quadruped.bvh");
-    let v = json(
-        &run("mo-metrics", &["generation", "--gt", s(&quad), "--gen", s(&quad), s(&quad), "--window", "10", "--min-segment", "15"], None),
-        "generation",
-    );
+    let v =
+        json(&run("mo-metrics", &["generation", "--gt", s(&quad), "--gen", s(&quad), s(&quad), "--window", "10", "--min-segment", "15"], None), "generation");
     assert_eq!(num(&v, "report.coverage.mean"), 100.0, "the ground truth covers itself");
     assert!(num(&v, "report.local_diversity.mean").abs() < 1e-9, "a sample that is a ground-truth clip has zero local diversity");
     assert!(num(&v, "report.inter_diversity.mean").abs() < 1e-9, "identical samples have zero inter diversity");

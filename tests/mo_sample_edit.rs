@@ -104,11 +104,13 @@ fn edits_keep_the_reference_and_generate_the_rest() {
     args.extend(["--sampler", "ddim", "--keep-joints", "*Thigh/"]);
     let b = run("mo-sample", &args, None);
     ok(&b, "body part");
-    let legs: Vec<usize> = (0..j).filter(|&jj| {
-        let names = ["Bip01_L_Thigh", "Bip01_L_Calf", "Bip01_L_Foot", "Bip01_L_Toe0", "Bip01_R_Thigh", "Bip01_R_Calf", "Bip01_R_Foot", "Bip01_R_Toe0"];
-        let arg = menagerie::cli::load::read_skeleton(&quad).unwrap();
-        names.contains(&arg.skeleton.joints[jj].name.as_str())
-    }).collect();
+    let legs: Vec<usize> = (0..j)
+        .filter(|&jj| {
+            let names = ["Bip01_L_Thigh", "Bip01_L_Calf", "Bip01_L_Foot", "Bip01_L_Toe0", "Bip01_R_Thigh", "Bip01_R_Calf", "Bip01_R_Foot", "Bip01_R_Toe0"];
+            let arg = menagerie::cli::load::read_skeleton(&quad).unwrap();
+            names.contains(&arg.skeleton.joints[jj].name.as_str())
+        })
+        .collect();
     assert_eq!(legs.len(), 8);
     for sample in samples(&b.stdout) {
         for f in 0..20 {

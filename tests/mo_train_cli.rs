@@ -55,7 +55,8 @@ fn a_signal_saves_a_checkpoint_that_resumes_the_same_run() {
         let step = info(&out)["step"].as_u64().unwrap();
         assert!(step >= 3 && stderr.contains(&format!("interrupted at step {step}, checkpoint saved; --resume to continue")), "{stderr}");
         assert_eq!(std::fs::read_to_string(&log).unwrap().lines().count() as u64, step, "the checkpoint holds every logged step");
-        let leftovers: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).filter(|n| n.ends_with(".tmp")).collect();
+        let leftovers: Vec<_> =
+            std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).filter(|n| n.ends_with(".tmp")).collect();
         assert!(leftovers.is_empty(), "{leftovers:?}");
         if signal == "-INT" {
             // Two more steps after the interruption equal a straight run of as many steps.
@@ -65,7 +66,11 @@ fn a_signal_saves_a_checkpoint_that_resumes_the_same_run() {
             ok(&run("mo-train", &resume, None), "resume");
             let straight = dir.join("straight");
             ok(&run("mo-train", &train_args(&data, &straight, &total), None), "straight");
-            assert_eq!(std::fs::read(straight.join("model.safetensors")).unwrap(), std::fs::read(out.join("model.safetensors")).unwrap(), "interrupted + resumed = straight");
+            assert_eq!(
+                std::fs::read(straight.join("model.safetensors")).unwrap(),
+                std::fs::read(out.join("model.safetensors")).unwrap(),
+                "interrupted + resumed = straight"
+            );
             assert_eq!(std::fs::read(straight.join("optimizer.safetensors")).unwrap(), std::fs::read(out.join("optimizer.safetensors")).unwrap());
         }
     }

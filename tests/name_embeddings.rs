@@ -54,7 +54,11 @@ fn spellings_of_left_foot_agree_and_differ_from_other_parts() {
     }
     let max_other = vs.iter().map(|a| cosine(a, &hand).max(cosine(a, &tail))).fold(f32::NEG_INFINITY, f32::max);
     let lr = cosine(&vs[0], &right_foot);
-    eprintln!("cos: spellings min {min_same:.4}, vs RightHand {:.4}, vs Tail_03 {:.4}, Left vs Right Foot {lr:.4}", cosine(&vs[0], &hand), cosine(&vs[0], &tail));
+    eprintln!(
+        "cos: spellings min {min_same:.4}, vs RightHand {:.4}, vs Tail_03 {:.4}, Left vs Right Foot {lr:.4}",
+        cosine(&vs[0], &hand),
+        cosine(&vs[0], &tail)
+    );
     assert!(min_same > max_other, "spellings {min_same} vs others {max_other}");
     assert!(lr < cosine(&vs[0], &vs[1]), "left/right kept apart: {lr}");
     assert!(lr < 0.99, "Left Foot and Right Foot nearly identical: {lr}");
@@ -95,7 +99,8 @@ fn unknown_names_fall_back_deterministically() {
     assert_unit(&t.embed_name(""), "empty name");
     assert_unit(&t.embed_name("L_Zzqx"), "side + unknown");
     let long = "Toe".repeat(500);
-    for odd in ["L", "R_", "__", ":", "Left", "ÄÖÜ_Fuß", "ǅ", "İstanbul", "足_L", "ﬀoot", "lowerneckneckneckneckneck", long.as_str(), "\u{0}\u{fffd}"] {
+    for odd in ["L", "R_", "__", ":", "Left", "ÄÖÜ_Fuß", "ǅ", "İstanbul", "足_L", "ﬀoot", "lowerneckneckneckneckneck", long.as_str(), "\u{0}\u{fffd}"]
+    {
         assert_unit(&t.embed_name(odd), odd);
     }
     let h = hash_unit_vector("abc", 384);
@@ -235,11 +240,8 @@ fn minilm_forward_matches_the_table() {
             names.extend(sk.joints.into_iter().map(|j| j.name));
         }
     }
-    let cos: Vec<f32> = names
-        .iter()
-        .filter(|n| matches!(t.embed_name_with_source(n).1, Source::Composed { .. }))
-        .map(|n| cosine(&t.embed_name(n), &m.embed_name(n)))
-        .collect();
+    let cos: Vec<f32> =
+        names.iter().filter(|n| matches!(t.embed_name_with_source(n).1, Source::Composed { .. })).map(|n| cosine(&t.embed_name(n), &m.embed_name(n))).collect();
     let mean = cos.iter().sum::<f32>() / cos.len().max(1) as f32;
     let min = cos.iter().copied().fold(1f32, f32::min);
     eprintln!("corpus names composed: {}, cosine to the exact embedding: mean {mean:.4}, min {min:.4}", cos.len());

@@ -136,8 +136,7 @@ fn finish(mut b: Browser, limit: Duration, what: &str) -> serde_json::Value {
     let text = start.and_then(|s| dom[s..].find("</pre>").map(|e| &dom[s..s + e])).unwrap_or("");
     // --dump-dom writes element text HTML-escaped.
     let text = text.replace("&lt;", "<").replace("&gt;", ">").replace("&quot;", "\"").replace("&amp;", "&");
-    serde_json::from_str(&text)
-        .unwrap_or_else(|e| panic!("{what}: no self test result ({e}) in the page: '{text}'\nchromium stderr:\n{tail}"))
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{what}: no self test result ({e}) in the page: '{text}'\nchromium stderr:\n{tail}"))
 }
 
 fn check(result: &serde_json::Value, what: &str) {
@@ -151,10 +150,7 @@ fn check(result: &serde_json::Value, what: &str) {
         assert!(ink.as_u64().unwrap() > 1000, "{what}: canvas almost blank at frame {i}: {result}");
     }
     let (tip, wanted) = (result["hover"].as_str().unwrap(), result["hoverWanted"].as_str().unwrap());
-    assert!(
-        !wanted.trim().is_empty() && tip.starts_with(wanted),
-        "{what}: hovering a joint shows '{tip}', not its name and track '{wanted}'"
-    );
+    assert!(!wanted.trim().is_empty() && tip.starts_with(wanted), "{what}: hovering a joint shows '{tip}', not its name and track '{wanted}'");
     for control in ["orbited", "panned", "zoomed", "played", "advanced"] {
         assert_eq!(result["controls"][control], true, "{what}: the page was not {control} by its controls: {result}");
     }
@@ -191,8 +187,7 @@ fn viewer_draws_moving_skeletons_in_chromium() {
     // Overlaid and following the root, no labels.
     let opts = HtmlOptions { overlay: true, follow: true, speed: 0.5, ..HtmlOptions::default() };
     let overlay = dir.join("overlay.html");
-    std::fs::write(&overlay, render_html(&[example_track("quadruped"), example_track("centipede")], &Legend::default(), &opts).unwrap())
-        .unwrap();
+    std::fs::write(&overlay, render_html(&[example_track("quadruped"), example_track("centipede")], &Legend::default(), &opts).unwrap()).unwrap();
 
     let built = started.elapsed();
     // Both browsers at once: the machine's cores mostly wait on browser start-up.
@@ -201,10 +196,7 @@ fn viewer_draws_moving_skeletons_in_chromium() {
     let limit = Duration::from_secs(60);
     let side_result = finish(a, limit, "side by side");
     let overlay_result = finish(b, limit, "overlay");
-    eprintln!(
-        "side by side: {side_result}\noverlay: {overlay_result}\nbrowser test took {:.2?} (pages built in {built:.2?})",
-        started.elapsed()
-    );
+    eprintln!("side by side: {side_result}\noverlay: {overlay_result}\nbrowser test took {:.2?} (pages built in {built:.2?})", started.elapsed());
     check(&side_result, "side by side");
     assert_eq!(side_result["views"], 2);
     check(&overlay_result, "overlay");
@@ -279,12 +271,7 @@ fn report(track: &Track) {
         })
         .fold(0.0, f64::max);
     // Distance between a point and where the page draws it.
-    let err = track
-        .positions
-        .iter()
-        .zip(&decoded)
-        .map(|(p, d)| (0..3).map(|a| (p[a] as f64 - d[a]).powi(2)).sum::<f64>().sqrt())
-        .fold(0.0, f64::max);
+    let err = track.positions.iter().zip(&decoded).map(|(p, d)| (0..3).map(|a| (p[a] as f64 - d[a]).powi(2)).sum::<f64>().sqrt()).fold(0.0, f64::max);
     let pf = track.frames * track.points();
     println!(
         "{}: {} frames x {} points: page {} bytes ({:.2} bytes per point-frame, {:.0} KB scaled to 5000x115), max error {:.3e} = {:.5}% of the body, built in {took:.2?}",

@@ -12,7 +12,7 @@
 //!   same skeleton as the BVH path; bad input exits 2 with one line and no file.
 mod common;
 
-use common::{tempdir, schema_validator};
+use common::{schema_validator, tempdir};
 
 use common::topology::{reference_distances, reference_relations};
 
@@ -21,8 +21,8 @@ use menagerie::augment::{self, Options, RemoveAmount};
 use menagerie::bvh::{self, Bvh};
 use menagerie::document::SkeletonDocument;
 use menagerie::motion::Motion;
-use menagerie::skeleton::{roles, topology, Skeleton};
 use menagerie::rng::SplitMix64;
+use menagerie::skeleton::{roles, topology, Skeleton};
 use std::path::Path;
 
 /// World positions must agree within this fraction of the skeleton's size.
@@ -34,7 +34,6 @@ const SEEDS: u64 = 3;
 
 // ---------------------------------------------------------------------------------------------
 // Brute-force topology (AnyTop §2.4), independent of lib/skeleton/topology.rs.
-
 
 fn check_topology(name: &str, skeleton: &Skeleton) {
     skeleton.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -422,7 +421,13 @@ fn tiny_skeleton_by_hand() {
     let s = Skeleton::from_bvh(&b);
     assert_eq!(names(&s), ["Hips", "Spine", "LeftFoot", "RightFoot"]);
     assert_eq!(s.joints[1].end_sites, vec![DVec3::new(0.0, 0.3, 0.0)]);
-    assert_eq!(b.values, vec![0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.1, 0.0, 0.0, 0.0, 20.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    assert_eq!(
+        b.values,
+        vec![
+            0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.1, 0.0, 0.0, 0.0, 20.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+            0.0
+        ]
+    );
     // Splitting: the only bones are Spine, Head, LeftFoot, RightFoot; each split halves one.
     let out = common::run("skel-aug", &["-", "--no-remove", "--add", "1", "--seed", "2"], Some(TINY.as_bytes()));
     let b = bvh::parse_bytes(&ok(&out, "tiny add"), "tiny").unwrap();

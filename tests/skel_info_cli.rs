@@ -3,7 +3,7 @@
 //! text output, broken pipes and atomic output behave as DESIGN.md promises.
 mod common;
 
-use common::{tempdir, schema_validator};
+use common::{schema_validator, tempdir};
 
 use menagerie::bvh;
 use menagerie::document::SkeletonDocument;
@@ -19,10 +19,7 @@ fn check_document(path: &Path, validator: &jsonschema::Validator) {
     assert!(errors.is_empty(), "{name}: schema errors: {errors:?}");
 
     let text = std::fs::read(path).unwrap();
-    let entries = String::from_utf8_lossy(&text)
-        .lines()
-        .filter(|l| matches!(l.split_whitespace().next(), Some("ROOT") | Some("JOINT")))
-        .count();
+    let entries = String::from_utf8_lossy(&text).lines().filter(|l| matches!(l.split_whitespace().next(), Some("ROOT") | Some("JOINT"))).count();
     let doc = SkeletonDocument::from_json(std::str::from_utf8(&out.stdout).unwrap()).unwrap();
     assert_eq!(doc.joint_count, entries, "{name}");
     assert_eq!(doc.joints.len(), entries, "{name}");
@@ -138,4 +135,3 @@ fn usage_errors_exit_2() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.starts_with("skel-info: ") && err.contains("/nonexistent/file.bvh") && err.trim_end().lines().count() == 1, "{err}");
 }
-

@@ -24,7 +24,6 @@ use std::path::Path;
 
 const DMAXES: [usize; 4] = [1, 2, 5, 8];
 
-
 /// First differing cell of two matrices, for a readable failure.
 fn first_difference(a: &[Vec<u8>], b: &[Vec<u8>]) -> Option<(usize, usize, u8, u8)> {
     assert_eq!(a.len(), b.len(), "matrix sizes differ");
@@ -87,11 +86,7 @@ fn check_chains(name: &str, skeleton: &Skeleton, has_child: &[bool]) {
     }
     for j in 0..n {
         let want = usize::from(parents[j].is_some());
-        assert_eq!(
-            seen_after_first[j], want,
-            "{name}: joint {j} appears {} times as a non-first chain element (want {want})",
-            seen_after_first[j]
-        );
+        assert_eq!(seen_after_first[j], want, "{name}: joint {j} appears {} times as a non-first chain element (want {want})", seen_after_first[j]);
     }
     assert!(chains.iter().any(|c| c[0] == 0), "{name}: no chain starts at the root");
 }
@@ -113,11 +108,7 @@ fn corpus_topology_matches_brute_force() {
     for path in &files {
         shapes.insert(check_bvh_file(path));
     }
-    println!(
-        "topology vs brute force: {} corpus files ({} distinct parent lists), dmax {DMAXES:?}",
-        files.len(),
-        shapes.len()
-    );
+    println!("topology vs brute force: {} corpus files ({} distinct parent lists), dmax {DMAXES:?}", files.len(), shapes.len());
 }
 
 #[test]
@@ -154,13 +145,7 @@ fn skeleton_from_parents(parents: &[Option<usize>]) -> Skeleton {
                     (format!("{side}Segment{j}"), offset, rot.to_vec())
                 }
             };
-            Joint {
-                name,
-                parent: parents[j],
-                offset,
-                channels,
-                end_sites: if has_child[j] { Vec::new() } else { vec![DVec3::new(0.0, 1.5, 0.5)] },
-            }
+            Joint { name, parent: parents[j], offset, channels, end_sites: if has_child[j] { Vec::new() } else { vec![DVec3::new(0.0, 1.5, 0.5)] } }
         })
         .collect();
     Skeleton { joints, frame_time: 1.0 / 30.0 }
@@ -273,26 +258,12 @@ fn brute_force_reference_on_a_hand_checked_tree() {
     let r = reference_relations(&parents);
     assert_eq!(
         r,
-        vec![
-            vec![0, 2, 4, 4, 2, 4],
-            vec![1, 0, 2, 2, 3, 4],
-            vec![4, 1, 5, 3, 4, 4],
-            vec![4, 1, 3, 5, 4, 4],
-            vec![1, 3, 4, 4, 0, 2],
-            vec![4, 4, 4, 4, 1, 5],
-        ]
+        vec![vec![0, 2, 4, 4, 2, 4], vec![1, 0, 2, 2, 3, 4], vec![4, 1, 5, 3, 4, 4], vec![4, 1, 3, 5, 4, 4], vec![1, 3, 4, 4, 0, 2], vec![4, 4, 4, 4, 1, 5],]
     );
     let d = reference_distances(&parents, 8);
     assert_eq!(
         d,
-        vec![
-            vec![0, 1, 2, 2, 1, 2],
-            vec![1, 0, 1, 1, 2, 3],
-            vec![2, 1, 0, 2, 3, 4],
-            vec![2, 1, 2, 0, 3, 4],
-            vec![1, 2, 3, 3, 0, 1],
-            vec![2, 3, 4, 4, 1, 0],
-        ]
+        vec![vec![0, 1, 2, 2, 1, 2], vec![1, 0, 1, 1, 2, 3], vec![2, 1, 0, 2, 3, 4], vec![2, 1, 2, 0, 3, 4], vec![1, 2, 3, 3, 0, 1], vec![2, 3, 4, 4, 1, 0],]
     );
     assert_eq!(reference_distances(&parents, 2)[2][5], 2);
     let skeleton = skeleton_from_parents(&parents);

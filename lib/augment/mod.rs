@@ -18,13 +18,13 @@ pub mod remove;
 pub mod subdivide;
 
 pub use edit::{Edit, EditError};
-pub use remove::{choose_removal, remove_chains, removable_chains, target_count, RemovalChoice, RemoveAmount};
+pub use remove::{choose_removal, removable_chains, remove_chains, target_count, RemovalChoice, RemoveAmount};
 pub use subdivide::{choose_splits, mid_name, splittable_bones, subdivide, Added};
 
 use crate::bvh::Bvh;
 use crate::motion::Motion;
-use crate::skeleton::{topology, Skeleton};
 use crate::rng::SplitMix64;
+use crate::skeleton::{topology, Skeleton};
 
 /// What to do to a skeleton: remove first (counted against the original joints), then add.
 #[derive(Clone, Copy, Debug, PartialEq)]

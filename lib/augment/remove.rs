@@ -15,11 +15,11 @@
 //! * nothing shared is mutated: the topology is rebuilt from the new skeleton (upstream writes
 //!   the end-effector mark into a shared relation array, which leaks into later samples).
 
-use super::edit::Edit;
 use super::below;
+use super::edit::Edit;
 use crate::motion::Motion;
-use crate::skeleton::{roles, Skeleton};
 use crate::rng::SplitMix64;
+use crate::skeleton::{roles, Skeleton};
 
 /// How many joints to remove.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -140,7 +140,10 @@ mod tests {
         t += &joint("Spine", "0 0.3 0");
         t += &(joint("Neck", "0 0.2 0") + &joint("Head", "0 0.1 0") + "}\n}\n");
         for side in ["L", "R"] {
-            t += &(joint(&format!("{side}Arm"), "0.2 0 0") + &joint(&format!("{side}Fore"), "0.2 0 0") + &joint(&format!("{side}Hand"), "0.1 0 0") + "}\n}\n}\n");
+            t += &(joint(&format!("{side}Arm"), "0.2 0 0")
+                + &joint(&format!("{side}Fore"), "0.2 0 0")
+                + &joint(&format!("{side}Hand"), "0.1 0 0")
+                + "}\n}\n}\n");
         }
         t += "}\n";
         t += &(joint("Tail", "0 0 -0.3") + "}\n");

@@ -12,8 +12,8 @@
 use super::below;
 use super::edit::Edit;
 use crate::motion::Motion;
-use crate::skeleton::Skeleton;
 use crate::rng::SplitMix64;
+use crate::skeleton::Skeleton;
 
 /// A bone shorter than this fraction of the skeleton's size is not split (a new joint on top
 /// of an old one teaches nothing).

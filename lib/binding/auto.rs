@@ -121,11 +121,8 @@ fn prepare(body: &Body, which: &'static str) -> Result<Prepared, AutoError> {
         })
         .collect();
     let side_word = |w: &str| matches!(w, "l" | "r" | "left" | "right");
-    let raw_words = s
-        .joints
-        .iter()
-        .map(|j| names::split_words(&j.name).into_iter().map(|w| w.to_ascii_lowercase()).filter(|w| !side_word(w)).collect())
-        .collect();
+    let raw_words =
+        s.joints.iter().map(|j| names::split_words(&j.name).into_iter().map(|w| w.to_ascii_lowercase()).filter(|w| !side_word(w)).collect()).collect();
     let candidates: Vec<usize> = (1..n).filter(|&j| !children[j].is_empty()).collect();
     if candidates.is_empty() {
         return Err(AutoError::NoCandidates { which });

@@ -37,14 +37,7 @@ pub enum Channel {
 }
 
 impl Channel {
-    pub const ALL: [Channel; 6] = [
-        Channel::Xposition,
-        Channel::Yposition,
-        Channel::Zposition,
-        Channel::Xrotation,
-        Channel::Yrotation,
-        Channel::Zrotation,
-    ];
+    pub const ALL: [Channel; 6] = [Channel::Xposition, Channel::Yposition, Channel::Zposition, Channel::Xrotation, Channel::Yrotation, Channel::Zrotation];
 
     pub fn name(self) -> &'static str {
         match self {

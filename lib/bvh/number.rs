@@ -6,10 +6,7 @@
 //! Everything else (long mantissas, big exponents) goes to the standard library, which is also
 //! correctly rounded, so the result never depends on which path ran. Measured in BENCHMARKS.md.
 
-const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
-];
+const POW10: [f64; 23] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22];
 
 /// Parse a BVH number: optional sign, digits with an optional `.`, optional exponent.
 /// Returns `None` for anything else, including `nan`, `inf` and empty text, because a
@@ -64,8 +61,7 @@ pub(super) fn parse_f64_prefix(s: &[u8]) -> Option<(f64, usize)> {
     }
     // Leading zeros (`0.000012`) add nothing to the sum, so it is exact unless there are more
     // than 19 significant digits (10^19 < 2^64). Only long numbers pay for counting them.
-    let exact = int_digits + frac_digits <= 19
-        || s[digits_start..i].iter().filter(|&&c| c != b'.').skip_while(|&&c| c == b'0').count() <= 19;
+    let exact = int_digits + frac_digits <= 19 || s[digits_start..i].iter().filter(|&&c| c != b'.').skip_while(|&&c| c == b'0').count() <= 19;
     let mut exp10 = -(frac_digits as i64);
     if i < s.len() && (s[i] == b'e' || s[i] == b'E') {
         i += 1;
@@ -105,10 +101,25 @@ mod tests {
     #[test]
     fn agrees_with_std_on_awkward_numbers() {
         let cases = [
-            "0", "-0", "1", "-171.350895", "0.1", "1e-5", "-1.5E+3", "123456789012345678901234",
-            "0.000000000000000000000001", "9007199254740993", "1.7976931348623157e308",
-            "4.9e-324", "2.2250738585072014e-308", ".5", "5.", "+3.25", "0.30000000000000004",
-            "1234567.8901234567", "-0.000005",
+            "0",
+            "-0",
+            "1",
+            "-171.350895",
+            "0.1",
+            "1e-5",
+            "-1.5E+3",
+            "123456789012345678901234",
+            "0.000000000000000000000001",
+            "9007199254740993",
+            "1.7976931348623157e308",
+            "4.9e-324",
+            "2.2250738585072014e-308",
+            ".5",
+            "5.",
+            "+3.25",
+            "0.30000000000000004",
+            "1234567.8901234567",
+            "-0.000005",
         ];
         for c in cases {
             let ours = parse_f64(c.as_bytes()).unwrap_or_else(|| panic!("rejected {c}"));

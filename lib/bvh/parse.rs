@@ -6,7 +6,10 @@
 //! stack), and the header's frame count is checked against the bytes that follow before any
 //! frame memory is reserved.
 
-use super::{number::{parse_f64, parse_f64_prefix}, Bvh, BvhError, BvhJoint, Channel};
+use super::{
+    number::{parse_f64, parse_f64_prefix},
+    Bvh, BvhError, BvhJoint, Channel,
+};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -55,7 +58,11 @@ fn is_space(b: u8) -> bool {
 /// 0x0B, which `is_space` and so the tokenizer treat as whitespace.)
 fn trim_space_end(mut s: &[u8]) -> &[u8] {
     while let [rest @ .., last] = s {
-        if is_space(*last) { s = rest } else { break }
+        if is_space(*last) {
+            s = rest
+        } else {
+            break;
+        }
     }
     s
 }
@@ -142,7 +149,11 @@ impl<'a> Cursor<'a> {
         }
         let mut s = &d[start..self.pos];
         while let [first, rest @ ..] = s {
-            if is_space(*first) { s = rest } else { break }
+            if is_space(*first) {
+                s = rest
+            } else {
+                break;
+            }
         }
         trim_space_end(s)
     }
@@ -205,27 +216,15 @@ impl Hierarchy {
         let (ntok, nline) = cur.expect_any("a channel count")?;
         let n = match std::str::from_utf8(ntok).ok().and_then(|s| s.parse::<usize>().ok()) {
             Some(n) if n <= MAX_CHANNELS_PER_JOINT => n,
-            _ => {
-                return cur.err(
-                    nline,
-                    format!("expected a channel count from 0 to {MAX_CHANNELS_PER_JOINT}, found '{}'", show(ntok)),
-                )
-            }
+            _ => return cur.err(nline, format!("expected a channel count from 0 to {MAX_CHANNELS_PER_JOINT}, found '{}'", show(ntok))),
         };
         let mut chans = Vec::with_capacity(n);
         for _ in 0..n {
             let (ctok, cline) = cur.expect_any("a channel name")?;
             match std::str::from_utf8(ctok).ok().and_then(Channel::from_name) {
                 Some(c) if !chans.contains(&c) => chans.push(c),
-                Some(c) => {
-                    return cur.err(cline, format!("channel {c} listed twice for joint '{}'", self.joints[j].name))
-                }
-                None => {
-                    return cur.err(
-                        cline,
-                        format!("expected a channel name (Xposition ... Zrotation), found '{}'", show(ctok)),
-                    )
-                }
+                Some(c) => return cur.err(cline, format!("channel {c} listed twice for joint '{}'", self.joints[j].name)),
+                None => return cur.err(cline, format!("expected a channel name (Xposition ... Zrotation), found '{}'", show(ctok))),
             }
         }
         self.joints[j].channels = chans;
@@ -239,20 +238,11 @@ fn parse_hierarchy(cur: &mut Cursor) -> Result<Vec<BvhJoint>, BvhError> {
     if !tok.eq_ignore_ascii_case(b"ROOT") {
         return cur.err(line, format!("expected 'ROOT', found '{}'", show(tok)));
     }
-    let mut h = Hierarchy {
-        joints: Vec::new(),
-        lines: Vec::new(),
-        has_offset: Vec::new(),
-        by_name: HashMap::new(),
-        stack: Vec::new(),
-    };
+    let mut h = Hierarchy { joints: Vec::new(), lines: Vec::new(), has_offset: Vec::new(), by_name: HashMap::new(), stack: Vec::new() };
     h.open_joint(cur, None, line)?;
     while let Some(&j) = h.stack.last() {
         let Some((tok, line)) = cur.next() else {
-            return cur.err(
-                cur.last_line,
-                format!("unexpected end of file: expected '}}' closing joint '{}'", h.joints[j].name),
-            );
+            return cur.err(cur.last_line, format!("unexpected end of file: expected '}}' closing joint '{}'", h.joints[j].name));
         };
         if tok.eq_ignore_ascii_case(b"OFFSET") {
             if h.has_offset[j] {
@@ -309,12 +299,7 @@ fn parse_motion_header(cur: &mut Cursor) -> Result<(usize, f64), BvhError> {
     };
     let frames = match std::str::from_utf8(count_tok.0).ok().and_then(|s| s.parse::<u64>().ok()) {
         Some(n) => n,
-        None => {
-            return cur.err(
-                count_tok.1,
-                format!("expected a frame count (a non-negative integer), found '{}'", show(count_tok.0)),
-            )
-        }
+        None => return cur.err(count_tok.1, format!("expected a frame count (a non-negative integer), found '{}'", show(count_tok.0))),
     };
     let frames_line = count_tok.1;
     cur.expect("Frame", "'Frame Time:'")?;
@@ -410,10 +395,7 @@ fn parse_frames(cur: &mut Cursor, joints: &[BvhJoint], frames: usize, channels: 
         line += 1;
     }
     if row != frames {
-        return cur.err(
-            line.saturating_sub(1).max(1),
-            format!("file ends after {row} frame rows, but 'Frames: {frames}' announced {frames}"),
-        );
+        return cur.err(line.saturating_sub(1).max(1), format!("file ends after {row} frame rows, but 'Frames: {frames}' announced {frames}"));
     }
     Ok(values)
 }

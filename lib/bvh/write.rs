@@ -27,8 +27,7 @@ pub fn write_string(bvh: &Bvh) -> String {
     s.push_str("HIERARCHY\n");
     let children = children_of(bvh);
     // Explicit stack of (joint, depth, entering?) so deep hierarchies cannot overflow.
-    let mut stack: Vec<(usize, usize, bool)> =
-        (0..bvh.joints.len()).rev().filter(|&j| bvh.joints[j].parent.is_none()).map(|j| (j, 0, true)).collect();
+    let mut stack: Vec<(usize, usize, bool)> = (0..bvh.joints.len()).rev().filter(|&j| bvh.joints[j].parent.is_none()).map(|j| (j, 0, true)).collect();
     while let Some((j, depth, entering)) = stack.pop() {
         let joint = &bvh.joints[j];
         let pad = "\t".repeat(depth.min(MAX_INDENT));

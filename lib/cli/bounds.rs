@@ -45,7 +45,11 @@ pub fn count(lo: usize, hi: usize) -> impl Fn(&str) -> Result<usize, String> + C
 
 fn number(text: &str) -> Result<f64, String> {
     let v: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number"))?;
-    if v.is_finite() { Ok(v) } else { Err(format!("'{text}' is not a finite number")) }
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("'{text}' is not a finite number"))
+    }
 }
 
 /// A number in `(0, max]`.
@@ -64,7 +68,11 @@ pub fn positive(max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send
 pub fn non_negative(max: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync + 'static {
     move |text| {
         let v = number(text)?;
-        if (0.0..=max).contains(&v) { Ok(v) } else { Err(format!("expected a number from 0 to {max}, found {text}")) }
+        if (0.0..=max).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("expected a number from 0 to {max}, found {text}"))
+        }
     }
 }
 

@@ -14,11 +14,9 @@ pub fn generated_files() -> Vec<(String, Vec<u8>)> {
         // Writing into a Vec cannot fail.
         let _ = clap_mangen::Man::new(cmd.clone()).render(&mut man);
         files.push((format!("man/{name}.1"), man));
-        for (shell, path) in [
-            (Shell::Bash, format!("completions/{name}.bash")),
-            (Shell::Zsh, format!("completions/_{name}")),
-            (Shell::Fish, format!("completions/{name}.fish")),
-        ] {
+        for (shell, path) in
+            [(Shell::Bash, format!("completions/{name}.bash")), (Shell::Zsh, format!("completions/_{name}")), (Shell::Fish, format!("completions/{name}.fish"))]
+        {
             let mut out = Vec::new();
             let mut c = cmd.clone();
             clap_complete::generate(shell, &mut c, name.clone(), &mut out);

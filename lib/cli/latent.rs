@@ -2,6 +2,7 @@
 //! --method latent`: load the SATA model, encode a clip into per-frame latents, decode latents
 //! onto a skeleton.
 
+use crate::bvh;
 use crate::cli::load::{read_skeleton, SkeletonArg};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
@@ -10,7 +11,6 @@ use crate::motion::Motion;
 use crate::sata::checkpoint::{self, Frozen};
 use crate::sata::infer::{Latents, Prepared};
 use crate::skeleton::Skeleton;
-use crate::bvh;
 use anyhow::{bail, Context};
 use candle_core::Device;
 use std::path::Path;
@@ -56,7 +56,8 @@ pub fn read_source(path: &Path, model: &Frozen, device: &Device) -> anyhow::Resu
     if motion.frames < 2 {
         bail!("{name}: {} frame(s); a clip needs at least 2 frames to encode (velocities need a next frame)", motion.frames);
     }
-    let (section, skeleton) = rig_for(model, &skeleton, || AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig")))?;
+    let (section, skeleton) =
+        rig_for(model, &skeleton, || AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig")))?;
     let prepared = Prepared::new(&skeleton, section, names()?, device).with_context(|| name.clone())?;
     Ok(SourceClip { name, skeleton, motion, prepared })
 }
@@ -112,6 +113,7 @@ pub fn latents_npy(latents: &Latents) -> anyhow::Result<Vec<u8>> {
 
 /// Decode onto the target as BVH text, `frame_time` seconds per frame.
 pub fn decode_bvh(model: &Frozen, latents: &Latents, target: &Target, frame_time: f64, device: &Device) -> anyhow::Result<String> {
-    let motion = model.decode_motion(latents, &target.fitted, &target.prepared, frame_time, device).with_context(|| format!("decoding onto {}", target.arg.name))?;
+    let motion =
+        model.decode_motion(latents, &target.fitted, &target.prepared, frame_time, device).with_context(|| format!("decoding onto {}", target.arg.name))?;
     Ok(bvh::write_string(&motion.to_bvh(&target.arg.skeleton)))
 }

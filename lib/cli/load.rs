@@ -15,7 +15,6 @@ use anyhow::{anyhow, bail, Context};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
-
 /// Where AnyTop decoding takes the rotations from.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DecodeFrom {
@@ -172,10 +171,7 @@ pub fn split_samples(array: NpyArray, name: &str) -> anyhow::Result<(Vec<Feature
             let samples = (0..n).map(|i| Features { frames, joints, dims, data: array.data[i * per..(i + 1) * per].to_vec() }).collect();
             Ok((samples, true))
         }
-        shape => bail!(
-            "{name}: expected a [frames, joints, dims] or [samples, frames, joints, dims] array, found shape {shape:?} (rank {})",
-            shape.len()
-        ),
+        shape => bail!("{name}: expected a [frames, joints, dims] or [samples, frames, joints, dims] array, found shape {shape:?} (rank {})", shape.len()),
     }
 }
 
@@ -299,9 +295,7 @@ fn decode_npy(array: NpyArray, name: &str, arg: &SkeletonArg, from: DecodeFrom) 
     let label = |i: usize| if batch { format!("{name}[{i}]") } else { name.to_string() };
     let mut out = Vec::with_capacity(samples.len());
     for (i, f) in samples.iter().enumerate() {
-        decoder.check(f, &arg.skeleton).map_err(|(e, hint)| {
-            anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name)
-        })?;
+        decoder.check(f, &arg.skeleton).map_err(|(e, hint)| anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name))?;
         let motion = decoder.decode(i, f, &arg.skeleton).map_err(|e| anyhow!("{}: {e}", label(i)))?;
         out.push(Loaded { name: label(i), skeleton: arg.skeleton.clone(), motion });
     }

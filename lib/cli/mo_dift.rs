@@ -118,7 +118,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => checkpoint::frozen_default(&device)?,
     };
     let defaults = if args.joints { DiftOptions::SPATIAL } else { DiftOptions::TEMPORAL };
-    let opts = DiftOptions { t: args.t.unwrap_or(defaults.t), layer: args.layer.unwrap_or(defaults.layer), draws: args.draws as usize, seed: args.common.seed, ..defaults };
+    let opts = DiftOptions {
+        t: args.t.unwrap_or(defaults.t),
+        layer: args.layer.unwrap_or(defaults.layer),
+        draws: args.draws as usize,
+        seed: args.common.seed,
+        ..defaults
+    };
     let motions = load_motions(&inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
     if motions.len() != inputs.len() {
         bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
@@ -144,7 +150,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 }
                 let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, args.bind_rate, auto::AutoOptions::default().min_pairs);
                 if choices.is_empty() {
-                    bail!("{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind", reference.name, target.name);
+                    bail!(
+                        "{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind",
+                        reference.name,
+                        target.name
+                    );
                 }
                 auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
             } else {
@@ -161,10 +171,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 Align::Monotonic => monotonic_matches(&sim),
                 Align::Nearest => best_matches(&sim),
             };
-            let rows: Vec<_> = matches
-                .iter()
-                .map(|m| FrameRow { target: m.target, reference: m.reference, score: round(m.score), margin: round(m.margin) })
-                .collect();
+            let rows: Vec<_> =
+                matches.iter().map(|m| FrameRow { target: m.target, reference: m.reference, score: round(m.score), margin: round(m.margin) }).collect();
             pretty(serde_json::json!({ "correspondence": "frames", "settings": header, "matches": rows }))
         };
         text.into_bytes()

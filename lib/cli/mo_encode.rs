@@ -26,9 +26,7 @@ use crate::cli::CommonOpts;
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
 use crate::io::npy;
 use crate::motion::Motion;
-use crate::repr::anytop::{
-    self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource,
-};
+use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource};
 use crate::repr::{m2m, Features};
 use crate::skeleton::{lookup, topology, Skeleton};
 use crate::{bvh, io};
@@ -402,8 +400,7 @@ fn check_outputs(args: &Args) -> anyhow::Result<()> {
 }
 
 fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
-    let encoded: Vec<(Features, Option<String>)> =
-        clips.par_iter().map(|c| (m2m::encode(&c.motion), m2m_loss_warning(&c.motion, &c.skeleton))).collect();
+    let encoded: Vec<(Features, Option<String>)> = clips.par_iter().map(|c| (m2m::encode(&c.motion), m2m_loss_warning(&c.motion, &c.skeleton))).collect();
     let (features, warnings): (Vec<Features>, Vec<Option<String>>) = encoded.into_iter().unzip();
     check_stackable(clips, &features)?;
     let first = &clips[0];
@@ -512,8 +509,7 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
             let section = AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options)
                 .with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
             // The document describes the encoded clips (their frame time), with the rig.
-            let document =
-                SkeletonDocument::build(&first.skeleton, first.info.clone(), &first.name, topology::DEFAULT_DMAX);
+            let document = SkeletonDocument::build(&first.skeleton, first.info.clone(), &first.name, topology::DEFAULT_DMAX);
             (document, section, rest.name.clone())
         }
     };
@@ -537,8 +533,7 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
         .map(|c| rig.encode(&c.skeleton, &c.motion).with_context(|| format!("{}: cannot encode with the AnyTop rig of {rig_name}", c.name)))
         .collect();
     let encoded = results.into_iter().collect::<anyhow::Result<Vec<anytop::Encoded>>>()?;
-    let (mut features, placements): (Vec<Features>, Vec<Placement>) =
-        encoded.into_iter().map(|e| (e.features, e.placement)).unzip();
+    let (mut features, placements): (Vec<Features>, Vec<Placement>) = encoded.into_iter().map(|e| (e.features, e.placement)).unzip();
     check_stackable(clips, &features)?;
     if args.common.verbose {
         for (clip, f) in clips.iter().zip(&features) {
@@ -653,7 +648,12 @@ fn refuse_terminal(output: Option<&Path>) -> anyhow::Result<()> {
 /// `want_stats` (they cost encoding the whole file).
 fn record_of(arg: &SkeletonArg, rest_pose: Option<&Clip>, args: &Args, want_stats: bool) -> anyhow::Result<AnyTopSection> {
     if let Some(section) = &arg.document.anytop {
-        let fixed = [(rest_pose.is_some(), "--rest-pose"), (args.face_joints.is_some(), "--face-joints"), (args.body_axis.is_some(), "--body-axis"), (args.feet.is_some(), "--feet")];
+        let fixed = [
+            (rest_pose.is_some(), "--rest-pose"),
+            (args.face_joints.is_some(), "--face-joints"),
+            (args.body_axis.is_some(), "--body-axis"),
+            (args.feet.is_some(), "--feet"),
+        ];
         if let Some((_, flag)) = fixed.iter().find(|(on, _)| *on) {
             bail!(
                 "{flag}: the AnyTop record of {} fixes the rig (rest pose, facing, feet); to build another, give --skeleton a BVH or a document without one (skel-info --no-anytop)",
@@ -670,12 +670,10 @@ fn record_of(arg: &SkeletonArg, rest_pose: Option<&Clip>, args: &Args, want_stat
         None => arg.own_rest(),
     };
     let options = anytop_options(args, &arg.skeleton, &arg.name, source)?;
-    let mut section =
-        AnyTopSection::new(&arg.skeleton, &rest, &options).with_context(|| format!("{}: cannot build an AnyTop rig", arg.name))?;
+    let mut section = AnyTopSection::new(&arg.skeleton, &rest, &options).with_context(|| format!("{}: cannot build an AnyTop rig", arg.name))?;
     if let Some(motion) = arg.motion.as_ref().filter(|m| want_stats && m.frames >= 2) {
         let own = section.rig.encode(&arg.skeleton, motion).with_context(|| format!("{}: statistics of its motion", arg.name))?;
-        section.stats =
-            Some(AnyTopStats::compute([&own.features]).with_context(|| format!("{}: statistics of its motion", arg.name))?);
+        section.stats = Some(AnyTopStats::compute([&own.features]).with_context(|| format!("{}: statistics of its motion", arg.name))?);
     }
     Ok(section)
 }
@@ -685,9 +683,7 @@ fn anytop_options(args: &Args, skeleton: &Skeleton, file: &str, rest_source: Res
     let mut options = AnyTopOptions { rest_source, ..AnyTopOptions::default() };
     if let Some(names) = &args.face_joints {
         let j = joint_indices("--face-joints", names, skeleton, file)?;
-        let Ok(four) = <[usize; 4]>::try_from(j) else {
-            bail!("--face-joints takes four joint names, R_HIP,L_HIP,R_SHOULDER,L_SHOULDER; got {}", names.len())
-        };
+        let Ok(four) = <[usize; 4]>::try_from(j) else { bail!("--face-joints takes four joint names, R_HIP,L_HIP,R_SHOULDER,L_SHOULDER; got {}", names.len()) };
         if four[0] == four[1] || four[2] == four[3] {
             bail!("--face-joints: the right and left joint of a pair must differ (R_HIP,L_HIP,R_SHOULDER,L_SHOULDER)");
         }
@@ -695,9 +691,7 @@ fn anytop_options(args: &Args, skeleton: &Skeleton, file: &str, rest_source: Res
     }
     if let Some(names) = &args.body_axis {
         let j = joint_indices("--body-axis", names, skeleton, file)?;
-        let Ok([front, back]) = <[usize; 2]>::try_from(j) else {
-            bail!("--body-axis takes two joint names, FRONT,BACK; got {}", names.len())
-        };
+        let Ok([front, back]) = <[usize; 2]>::try_from(j) else { bail!("--body-axis takes two joint names, FRONT,BACK; got {}", names.len()) };
         if front == back {
             bail!("--body-axis: FRONT and BACK must be different joints");
         }
@@ -738,13 +732,7 @@ fn describe_rig(rig: &AnyTopRig, skeleton: &Skeleton) -> String {
         Facing::FaceJoints(f) => format!("face joints {}, {}, {}, {}", name(f[0]), name(f[1]), name(f[2]), name(f[3])),
         Facing::BodyAxis { front, back } => format!("body axis {} -> {}", name(*back), name(*front)),
     };
-    format!(
-        "{rest}; {facing} ({}); {} foot joint(s) ({}); scale {:.6}",
-        how(rig.facing_source),
-        rig.feet.len(),
-        how(rig.feet_source),
-        rig.scale_factor
-    )
+    format!("{rest}; {facing} ({}); {} foot joint(s) ({}); scale {:.6}", how(rig.facing_source), rig.feet.len(), how(rig.feet_source), rig.scale_factor)
 }
 
 fn decode(args: &Args) -> anyhow::Result<()> {
@@ -789,9 +777,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     // Check everything before writing anything.
     let label = |i: usize| if batch { format!("{name}: sample {i}") } else { name.clone() };
     for (i, f) in samples.iter().enumerate() {
-        decoder.check(f, skeleton).map_err(|(e, hint)| {
-            anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name)
-        })?;
+        decoder.check(f, skeleton).map_err(|(e, hint)| anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name))?;
     }
     let target = args.common.output.as_deref();
     let paths: Vec<Option<PathBuf>> = if target.is_none_or(is_dash) {
@@ -801,9 +787,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         vec![None]
     } else {
         let pattern = target.expect("checked above");
-        (0..samples.len())
-            .map(|i| io::numbered_output(pattern, i, samples.len()).map(Some).map_err(anyhow::Error::msg))
-            .collect::<anyhow::Result<_>>()?
+        (0..samples.len()).map(|i| io::numbered_output(pattern, i, samples.len()).map(Some).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?
     };
 
     let texts: Vec<anyhow::Result<String>> = samples
@@ -816,13 +800,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         .collect();
     let texts = texts.into_iter().collect::<anyhow::Result<Vec<String>>>()?;
     if args.common.verbose {
-        eprintln!(
-            "mo-encode: {name}: {} sample(s) of {} frames decoded on {}",
-            samples.len(),
-            samples.first().map_or(0, |f| f.frames),
-            arg.name
-        );
+        eprintln!("mo-encode: {name}: {} sample(s) of {} frames decoded on {}", samples.len(), samples.first().map_or(0, |f| f.frames), arg.name);
     }
     write_outputs(paths.into_iter().zip(texts.into_iter().map(String::into_bytes)).collect())
 }
-

@@ -239,7 +239,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         Command::Aggregate { reports } => run_aggregate(reports)?,
         Command::Generation { gt, generated, window, threshold, min_segment } => {
-            let opts = GenerationOptions { window: *window, threshold: *threshold, min_segment: *min_segment, seed: args.common.seed, ..GenerationOptions::default() };
+            let opts =
+                GenerationOptions { window: *window, threshold: *threshold, min_segment: *min_segment, seed: args.common.seed, ..GenerationOptions::default() };
             run_generation(args, gt, generated, &opts)?
         }
     };
@@ -343,8 +344,8 @@ fn run_reconstruction(args: &Args, reference: &Path, result: &Path, height: Opti
     let (ca, cb) = (clip_of(&a)?, clip_of(&b)?);
     let counted = reconstruction::rotation_joints(&a.skeleton);
     let rotations = reconstruction::Rotations { reference: &a.motion.rotations, result: &b.motion.rotations, counted };
-    let report = reconstruction::reconstruction(&ca, &cb, Some(&rotations), height, &PhysicsOptions::default())
-        .with_context(|| format!("{} vs {}", a.name, b.name))?;
+    let report =
+        reconstruction::reconstruction(&ca, &cb, Some(&rotations), height, &PhysicsOptions::default()).with_context(|| format!("{} vs {}", a.name, b.name))?;
     Ok(json!({
         "metric": "reconstruction",
         "reference": a.name,
@@ -373,7 +374,8 @@ fn run_transfer(
     let pairs: Vec<(usize, usize)> = match binding {
         Some(path) => {
             let name = io::display_name(path);
-            let text = String::from_utf8(io::read_input(path).with_context(|| format!("cannot read {name}"))?).map_err(|_| anyhow::anyhow!("{name}: not UTF-8"))?;
+            let text =
+                String::from_utf8(io::read_input(path).with_context(|| format!("cannot read {name}"))?).map_err(|_| anyhow::anyhow!("{name}: not UTF-8"))?;
             let b = Binding::from_json(&text, &name)?;
             b.resolve(&name, &src.skeleton, &src.name, &target.skeleton, &target.name)?
         }
@@ -413,14 +415,17 @@ fn run_transfer(
         let ex = load(args, examples)?;
         for e in &ex {
             if e.skeleton.len() != target.skeleton.len() {
-                bail!("example {} has {} joints but the results have {}: the examples are clips of the target skeleton", e.name, e.skeleton.len(), target.skeleton.len());
+                bail!(
+                    "example {} has {} joints but the results have {}: the examples are clips of the target skeleton",
+                    e.name,
+                    e.skeleton.len(),
+                    target.skeleton.len()
+                );
             }
         }
         let ex_clips = ex.iter().map(clip_of).collect::<anyhow::Result<Vec<Clip>>>()?;
         let (ex_sets, result_sets) = (windows(&ex_clips, fid_window), windows(&clips, fid_window));
-        let kin = |cs: &[Clip]| -> anyhow::Result<Vec<Vec<f64>>> {
-            cs.iter().map(|c| kinetic::kinetic_features(c).context("kinetic features")).collect()
-        };
+        let kin = |cs: &[Clip]| -> anyhow::Result<Vec<Vec<f64>>> { cs.iter().map(|c| kinetic::kinetic_features(c).context("kinetic features")).collect() };
         m.insert("fid_kinetic".into(), fid_value(&kin(&ex_sets)?, &kin(&result_sets)?)?);
         let fid_g = match geometric::human_roles(&clips[0]) {
             Ok(roles) => {
@@ -646,7 +651,11 @@ fn flatten(prefix: &str, v: &Value, units: &Map<String, Value>, rows: &mut Vec<(
             _ => leaf,
         };
         let unit = units.get(owner).and_then(Value::as_str).unwrap_or("");
-        if leaf == "normalised" { unit.replace("clip length units", "skeleton sizes").replace("target length units", "skeleton sizes") } else { unit.to_string() }
+        if leaf == "normalised" {
+            unit.replace("clip length units", "skeleton sizes").replace("target length units", "skeleton sizes")
+        } else {
+            unit.to_string()
+        }
     };
     match v {
         Value::Object(m) => {

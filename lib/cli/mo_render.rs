@@ -145,7 +145,11 @@ fn parse_view(s: &str) -> Result<View, String> {
 fn parse_range(s: &str) -> Result<(Option<usize>, Option<usize>), String> {
     let (a, b) = s.split_once(':').ok_or_else(|| format!("expected START:END, found '{s}'"))?;
     let num = |t: &str| -> Result<Option<usize>, String> {
-        if t.trim().is_empty() { Ok(None) } else { t.trim().parse().map(Some).map_err(|_| format!("'{t}' is not a frame number")) }
+        if t.trim().is_empty() {
+            Ok(None)
+        } else {
+            t.trim().parse().map(Some).map_err(|_| format!("'{t}' is not a frame number"))
+        }
     };
     let (start, end) = (num(a)?, num(b)?);
     if let (Some(s0), Some(e)) = (start, end) {
@@ -157,7 +161,8 @@ fn parse_range(s: &str) -> Result<(Option<usize>, Option<usize>), String> {
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.to_ascii_lowercase().split_once('x').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected WIDTHxHEIGHT, found '{s}'"))?;
+    let (w, h) =
+        s.to_ascii_lowercase().split_once('x').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected WIDTHxHEIGHT, found '{s}'"))?;
     let w: u32 = w.trim().parse().map_err(|_| format!("width '{w}' is not a whole number"))?;
     let h: u32 = h.trim().parse().map_err(|_| format!("height '{h}' is not a whole number"))?;
     if !(32..=4096).contains(&w) || !(32..=4096).contains(&h) {
@@ -182,7 +187,9 @@ fn outputs(args: &Args) -> anyhow::Result<Vec<(Kind, Option<PathBuf>)>> {
             (None, Some(k)) => k,
             (None, None) => match o {
                 Some(p) if !is_dash(p) => bail!("{}: cannot tell the picture kind from the extension: use .png, .gif or .html, or --format", p.display()),
-                _ if out.is_empty() => bail!("say what to draw: --sheet out.png, --gif out.gif, --html out.html, or -o with one of those extensions (--format for stdout)"),
+                _ if out.is_empty() => {
+                    bail!("say what to draw: --sheet out.png, --gif out.gif, --html out.html, or -o with one of those extensions (--format for stdout)")
+                }
                 _ => bail!("-o - needs --format sheet|gif|html"),
             },
         };
@@ -205,7 +212,6 @@ fn kind_of_extension(p: &Path) -> Option<Kind> {
         _ => None,
     }
 }
-
 
 /// The first drawn frame and the tracks.
 fn tracks(loaded: &[Loaded], range: Option<(Option<usize>, Option<usize>)>) -> anyhow::Result<(usize, Vec<Track>)> {

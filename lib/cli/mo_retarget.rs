@@ -5,6 +5,7 @@
 
 use crate::binding::auto::{self, AutoOptions, Body};
 use crate::binding::{Binding, JointMap};
+use crate::bvh;
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, is_dash};
 use crate::cli::CommonOpts;
@@ -15,7 +16,6 @@ use crate::repr::anytop::AnyTopOptions;
 use crate::repr::m2m;
 use crate::retarget::{self, BoundRotation, Repr, RootMotion, Settings};
 use crate::skeleton::Skeleton;
-use crate::bvh;
 use anyhow::{bail, Context};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -181,7 +181,10 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
         (args.key_frames.is_some(), "--key-frames"),
         (args.format == OutFormat::Npy, "--format npy"),
         (args.patch.is_some() || args.alpha.is_some() || args.steps.is_some() || args.pyramid.is_some(), "--patch/--alpha/--steps/--pyramid"),
-        (args.repr.is_some() || args.bound_rotation.is_some() || args.root_motion.is_some() || args.copy_bound, "--repr/--bound-rotation/--root-motion/--copy-bound"),
+        (
+            args.repr.is_some() || args.bound_rotation.is_some() || args.root_motion.is_some() || args.copy_bound,
+            "--repr/--bound-rotation/--root-motion/--copy-bound",
+        ),
     ];
     if let Some((_, flag)) = m2m_only.iter().find(|(on, _)| *on) {
         bail!("{flag} belongs to --method m2m; the latent method decodes one motion, as long as the source");
@@ -363,13 +366,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let target_fps = 1.0 / first.motion.frame_time;
     if let Some(e) = examples.iter().find(|e| (e.motion.frame_time - first.motion.frame_time).abs() > 1e-6 * first.motion.frame_time) {
-        bail!(
-            "{} runs at {:.3} fps but {} at {:.3} fps: give example clips of one frame rate",
-            e.name,
-            1.0 / e.motion.frame_time,
-            first.name,
-            target_fps
-        );
+        bail!("{} runs at {:.3} fps but {} at {:.3} fps: give example clips of one frame rate", e.name, 1.0 / e.motion.frame_time, first.name, target_fps);
     }
 
     // The binding.
@@ -467,11 +464,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             examples.iter().map(|e| e.motion.frames).sum::<usize>(),
             first.skeleton.len()
         );
-        eprintln!(
-            "mo-retarget: binding: {} pairs, rate {:.1}%",
-            map.len(),
-            100.0 * Binding::rate(map.len(), source.skeleton.len(), first.skeleton.len())
-        );
+        eprintln!("mo-retarget: binding: {} pairs, rate {:.1}%", map.len(), 100.0 * Binding::rate(map.len(), source.skeleton.len(), first.skeleton.len()));
         for (p, &(s, t)) in binding.mapping.iter().zip(&map) {
             let score = p.score.map(|x| format!(" (score {x:.3})")).unwrap_or_default();
             eprintln!("mo-retarget:   {} -> {}{score}", source.skeleton.joints[s].name, first.skeleton.joints[t].name);

@@ -1,5 +1,6 @@
 //! `mo-sample`: generate motion for any skeleton with a trained denoiser.
 
+use crate::bvh;
 use crate::cli::load::read_skeleton;
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
@@ -11,7 +12,6 @@ use crate::io::{self, npy};
 use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
 use crate::repr::smooth::lambda_for_cutoff;
 use crate::repr::Features;
-use crate::bvh;
 use anyhow::{bail, Context};
 use candle_core::Device;
 use std::path::PathBuf;
@@ -279,7 +279,12 @@ fn smoothing(hz: f64, fps: f64) -> anyhow::Result<Option<f64>> {
 }
 
 /// Read and encode `--reference` on the rig of the skeleton being sampled.
-fn read_reference(path: &std::path::Path, skeleton_name: &str, skeleton: &crate::skeleton::Skeleton, rig: &crate::repr::anytop::AnyTopRig) -> anyhow::Result<Reference> {
+fn read_reference(
+    path: &std::path::Path,
+    skeleton_name: &str,
+    skeleton: &crate::skeleton::Skeleton,
+    rig: &crate::repr::anytop::AnyTopRig,
+) -> anyhow::Result<Reference> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read the reference {name}"))?;
     let parsed = bvh::parse_bytes(&bytes, &name).with_context(|| format!("the reference {name}"))?;

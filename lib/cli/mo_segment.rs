@@ -4,6 +4,7 @@
 //! (`frame_features`: the place where feature providers plug in), runs `segment::segment`, and
 //! writes JSON that `mo-render --frame-labels` reads.
 
+use crate::bvh;
 use crate::cli::bounds;
 use crate::cli::load::{is_dash, read_skeleton, split_samples};
 use crate::cli::CommonOpts;
@@ -14,9 +15,8 @@ use crate::io::{self, npy};
 use crate::motion::Motion;
 use crate::repr::anytop::FEATURE_DIMS;
 use crate::repr::Features as ReprFeatures;
-use crate::segment::{self, Segmentation, SegmentOptions};
+use crate::segment::{self, SegmentOptions, Segmentation};
 use crate::skeleton::Skeleton;
-use crate::bvh;
 use anyhow::{anyhow, bail, Context};
 use std::path::PathBuf;
 
@@ -162,7 +162,11 @@ impl Input {
 }
 
 fn usable_frame_time(t: f64) -> f64 {
-    if t.is_finite() && t > 0.0 { t } else { 1.0 / 30.0 }
+    if t.is_finite() && t > 0.0 {
+        t
+    } else {
+        1.0 / 30.0
+    }
 }
 
 /// `--features raw`: `segment::raw_frame_features` of the clip's AnyTop features, one row per
@@ -205,7 +209,11 @@ pub fn dift_features(model: &checkpoint::Frozen, input: &Input, opts: &DiftOptio
 
 /// `--window` seconds as frames at `frame_time` (0 = none).
 pub fn window_frames(seconds: f64, frame_time: f64) -> usize {
-    if seconds > 0.0 && frame_time > 0.0 { (seconds / frame_time).round() as usize } else { 0 }
+    if seconds > 0.0 && frame_time > 0.0 {
+        (seconds / frame_time).round() as usize
+    } else {
+        0
+    }
 }
 
 /// Segment `features` of `input` and return the result in BVH frames (labels extended to every

@@ -123,7 +123,8 @@ pub struct Args {
 fn parse_probability(text: &str) -> Result<f64, String> {
     let value = match text.split_once('/') {
         Some((a, b)) => {
-            let (a, b): (f64, f64) = (a.trim().parse().map_err(|_| format!("'{text}' is not a fraction"))?, b.trim().parse().map_err(|_| format!("'{text}' is not a fraction"))?);
+            let (a, b): (f64, f64) =
+                (a.trim().parse().map_err(|_| format!("'{text}' is not a fraction"))?, b.trim().parse().map_err(|_| format!("'{text}' is not a fraction"))?);
             a / b
         }
         None => text.trim().parse().map_err(|_| format!("'{text}' is not a number"))?,

@@ -4,8 +4,8 @@
 use crate::augment::{self, Plan, RemoveAmount};
 use crate::cli::CommonOpts;
 use crate::document::SkeletonDocument;
-use crate::skeleton::Skeleton;
 use crate::rng::SplitMix64;
+use crate::skeleton::Skeleton;
 use crate::{bvh, io};
 use anyhow::{bail, Context};
 use std::collections::BTreeSet;
@@ -133,8 +133,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 let source = format!("{} (skel-aug --seed {} variant {i})", d.source, args.common.seed);
                 let motion = if plan.is_empty() { d.motion.clone() } else { None };
                 let doc = SkeletonDocument::build(&plan.skeleton, motion, &source, d.topology.dmax);
-                let mut json = if args.pretty { serde_json::to_string_pretty(&doc) } else { serde_json::to_string(&doc) }
-                    .context("serialising the skeleton document")?;
+                let mut json =
+                    if args.pretty { serde_json::to_string_pretty(&doc) } else { serde_json::to_string(&doc) }.context("serialising the skeleton document")?;
                 json.push('\n');
                 json
             }
@@ -185,7 +185,11 @@ fn warnings(plan: &Plan, skeleton: &Skeleton, add: usize, keep_feet: bool) -> Ve
     let n = plan.joints_before;
     if let Some(r) = &plan.removal {
         if r.removed.len() < r.target {
-            let why = if keep_feet { "chains ending in end effectors stop at feet, branching joints and the root" } else { "chains stop at branching joints and the root" };
+            let why = if keep_feet {
+                "chains ending in end effectors stop at feet, branching joints and the root"
+            } else {
+                "chains stop at branching joints and the root"
+            };
             let mut w = if r.removable == 0 {
                 format!("none of the {n} joints can be removed ({why})")
             } else {

@@ -163,7 +163,11 @@ pub fn text_report(doc: &SkeletonDocument) -> String {
         let mut prefix = String::new();
         for (k, &last) in lasts.iter().enumerate() {
             prefix.push_str(if k + 1 == lasts.len() {
-                if last { "└─" } else { "├─" }
+                if last {
+                    "└─"
+                } else {
+                    "├─"
+                }
             } else if last {
                 "  "
             } else {
@@ -203,7 +207,14 @@ pub fn text_report(doc: &SkeletonDocument) -> String {
     }
     let t = &doc.topology;
     let names = |idx: &[usize]| idx.iter().map(|&j| doc.joints[j].name.as_str()).collect::<Vec<_>>().join(", ");
-    let _ = writeln!(s, "  joints: {}   chains: {}   end effectors: {}   max depth: {}", doc.joint_count, t.chains.len(), t.end_effectors.len(), doc.joints.iter().map(|e| e.depth).max().unwrap_or(0));
+    let _ = writeln!(
+        s,
+        "  joints: {}   chains: {}   end effectors: {}   max depth: {}",
+        doc.joint_count,
+        t.chains.len(),
+        t.end_effectors.len(),
+        doc.joints.iter().map(|e| e.depth).max().unwrap_or(0)
+    );
     let _ = writeln!(s, "  feet ({:?}): {}", t.foot_rule, if t.feet.is_empty() { "none".into() } else { names(&t.feet) });
     let sides = |side: Side| doc.joints.iter().filter(|e| e.side == side).count();
     let _ = writeln!(s, "  sides: {} left, {} right, {} centre", sides(Side::Left), sides(Side::Right), sides(Side::Centre));

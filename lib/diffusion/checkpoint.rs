@@ -152,7 +152,8 @@ pub fn load(dir: &Path, device: &Device) -> Result<Loaded, CheckpointError> {
 /// The bytes of `dir`'s `checkpoint.json` and `model.safetensors`.
 pub fn read_dir_files(dir: &Path) -> Result<(Vec<u8>, Vec<u8>), CheckpointError> {
     let path = dir.join("checkpoint.json");
-    let info = std::fs::read(&path).map_err(CheckpointError::io(format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display())))?;
+    let info =
+        std::fs::read(&path).map_err(CheckpointError::io(format!("cannot read {} (is {} a model directory from mo-train?)", path.display(), dir.display())))?;
     let weights = dir.join("model.safetensors");
     let bytes = std::fs::read(&weights).map_err(CheckpointError::io(format!("cannot read {}", weights.display())))?;
     Ok((info, bytes))
@@ -188,7 +189,8 @@ pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<L
 /// Overwrite every variable of `varmap` with the tensor of the same name in the safetensors
 /// bytes `weights`; a missing or misshapen one is an error.
 pub fn fill_vars(varmap: &VarMap, weights: &[u8], device: &Device) -> Result<(), CheckpointError> {
-    let tensors = candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
+    let tensors =
+        candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
     let vars = varmap.data().lock().map_err(|_| CheckpointError::Invalid("the parameter map is poisoned".into()))?;
     for (name, var) in vars.iter() {
         let Some(t) = tensors.get(name) else { return Err(CheckpointError::Invalid(format!("model.safetensors: parameter {name} is missing"))) };
@@ -213,7 +215,8 @@ pub struct Frozen {
 /// `Frozen` from the bytes of `checkpoint.json` and `model.safetensors`.
 pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<Frozen, CheckpointError> {
     let info = parse_info(info_json)?;
-    let tensors = candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
+    let tensors =
+        candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
     let model = Denoiser::new(vb, &info.config).map_err(CheckpointError::Mismatch)?;
     Ok(Frozen { info, model })

@@ -7,11 +7,11 @@
 
 use super::checkpoint::{find_trained, CheckpointInfo};
 use super::sample::Condition;
+use super::DiffusionError;
 use crate::embed::NameTable;
 use crate::repr::anytop::{AnyTopStats, FEATURE_DIMS};
 use crate::repr::Features;
 use crate::skeleton::{topology, Skeleton};
-use super::DiffusionError;
 
 /// Where the normalisation statistics came from (tools say so when it is the fallback).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,7 +49,13 @@ impl SkeletonCondition {
 
     /// The condition with the given statistics (e.g. always the caller's own, so that two
     /// motions compared with each other are normalised alike).
-    pub fn with_stats(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], stats: AnyTopStats, stats_source: StatsSource) -> Result<SkeletonCondition, DiffusionError> {
+    pub fn with_stats(
+        info: &CheckpointInfo,
+        skeleton: &Skeleton,
+        rest_row: &[Vec<f32>],
+        stats: AnyTopStats,
+        stats_source: StatsSource,
+    ) -> Result<SkeletonCondition, DiffusionError> {
         let mut rest = Features { frames: 1, joints: skeleton.len(), dims: FEATURE_DIMS, data: rest_row.concat() };
         stats.normalise(&mut rest).map_err(|source| DiffusionError::Stats { what: "normalising the rest pose", source })?;
         let names = NameTable::builtin().map_err(DiffusionError::Names)?.embed_skeleton(skeleton);

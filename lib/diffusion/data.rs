@@ -28,8 +28,8 @@ use crate::embed::NameTable;
 use crate::motion::Motion;
 use crate::repr::anytop::{self, AnyTopOptions, AnyTopStats, RestSource};
 use crate::repr::Features;
-use crate::skeleton::{topology, Skeleton};
 use crate::rng::SplitMix64;
+use crate::skeleton::{topology, Skeleton};
 use std::borrow::Cow;
 use std::path::Path;
 
@@ -163,8 +163,13 @@ fn group_names(groups: &[Vec<RawClip>]) -> Vec<String> {
             }
             let prefix = prefix.trim_end_matches(['_', '-', '.', ' ']).to_string();
             // A prefix that other groups' files share too (`dataset-1_...`) says nothing.
-            let distinctive = prefix.chars().count() >= 2 && groups.iter().enumerate().all(|(k, g)| k == i || g.iter().all(|c| !stem_of(&c.name).starts_with(&prefix)));
-            if distinctive { prefix } else { stems[0].clone() }
+            let distinctive =
+                prefix.chars().count() >= 2 && groups.iter().enumerate().all(|(k, g)| k == i || g.iter().all(|c| !stem_of(&c.name).starts_with(&prefix)));
+            if distinctive {
+                prefix
+            } else {
+                stems[0].clone()
+            }
         };
         let mut unique = name.clone();
         let mut k = 2;
@@ -190,9 +195,11 @@ fn prepare<'a>(
     dropped: &mut Vec<String>,
 ) -> Result<Option<SkeletonData>, DataError> {
     let (rest_name, rest_motion) = rest;
-    let source = if anytop::names_tpose(rest_name) { RestSource::TPose { file: rest_name.to_string() } } else { RestSource::FirstClip { file: rest_name.to_string() } };
+    let source =
+        if anytop::names_tpose(rest_name) { RestSource::TPose { file: rest_name.to_string() } } else { RestSource::FirstClip { file: rest_name.to_string() } };
     let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
-    let section = AnyTopSection::new(&skeleton, &rest_motion.first_frames(2), &options).map_err(|e| DataError::Clip { clip: rest_name.to_string(), why: e.to_string() })?;
+    let section = AnyTopSection::new(&skeleton, &rest_motion.first_frames(2), &options)
+        .map_err(|e| DataError::Clip { clip: rest_name.to_string(), why: e.to_string() })?;
     let mut features = Vec::new();
     let mut clip_names = Vec::new();
     for (clip, motion) in clips {
@@ -253,7 +260,15 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
 /// Variants whose edit changes nothing, or whose clips are all too short, are left out; so are
 /// variants that cannot be prepared (returned with the reason): an augmentation is never
 /// worth failing a training run for.
-fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawClip, aug: &Augmentation, names: &NameTable, dmax: usize) -> (Vec<SkeletonData>, Vec<String>) {
+fn variants_of(
+    index: usize,
+    base: &SkeletonData,
+    group: &[RawClip],
+    rest: &RawClip,
+    aug: &Augmentation,
+    names: &NameTable,
+    dmax: usize,
+) -> (Vec<SkeletonData>, Vec<String>) {
     let (mut out, mut skipped) = (Vec::new(), Vec::new());
     for v in 0..aug.variants {
         // One stream per (seed, skeleton, variant): adding a skeleton or a variant leaves the
@@ -278,7 +293,11 @@ fn variants_of(index: usize, base: &SkeletonData, group: &[RawClip], rest: &RawC
         let rest_motion = plan.apply_motion(&base.skeleton, &rest.motion.first_frames(2));
         let clips = pieces.into_iter().map(|(c, range)| {
             let clip = usable[c];
-            let motion = if range == (0..clip.motion.frames) { plan.apply_motion(&base.skeleton, &clip.motion) } else { plan.apply_motion(&base.skeleton, &clip.motion.frame_range(range.start, range.end)) };
+            let motion = if range == (0..clip.motion.frames) {
+                plan.apply_motion(&base.skeleton, &clip.motion)
+            } else {
+                plan.apply_motion(&base.skeleton, &clip.motion.frame_range(range.start, range.end))
+            };
             (clip.name.clone(), Cow::Owned(motion))
         });
         let mut ignored = Vec::new();

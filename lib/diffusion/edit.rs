@@ -127,8 +127,7 @@ pub fn select_joints(skeleton: &Skeleton, list: &str) -> Result<Vec<usize>, Edit
         };
         let roots: Vec<usize> = if pattern.contains(['*', '?']) {
             let want: Vec<char> = pattern.to_lowercase().chars().collect();
-            let hits: Vec<usize> =
-                (0..skeleton.len()).filter(|&j| glob(&want, &skeleton.joints[j].name.to_lowercase().chars().collect::<Vec<_>>())).collect();
+            let hits: Vec<usize> = (0..skeleton.len()).filter(|&j| glob(&want, &skeleton.joints[j].name.to_lowercase().chars().collect::<Vec<_>>())).collect();
             if hits.is_empty() {
                 let bare: String = pattern.chars().filter(|c| !matches!(c, '*' | '?')).collect();
                 return Err(EditError::NoJoint { pattern: item.to_string(), closest: lookup::closest_names(skeleton, &bare, 5) });
@@ -252,10 +251,7 @@ pub struct Seam {
 /// The velocity jump at every seam between kept (`whole_frames`) and generated frames.
 pub fn seam_jump(positions: &[DVec3], joints: usize, kept_frames: &[bool]) -> Vec<Seam> {
     let jumps = boundary_jumps(positions, joints);
-    (1..kept_frames.len())
-        .filter(|&b| kept_frames[b] != kept_frames[b - 1])
-        .filter_map(|b| jumps.get(b - 1).map(|&jump| Seam { frame: b, jump }))
-        .collect()
+    (1..kept_frames.len()).filter(|&b| kept_frames[b] != kept_frames[b - 1]).filter_map(|b| jumps.get(b - 1).map(|&jump| Seam { frame: b, jump })).collect()
 }
 
 /// A distribution of `boundary_jumps` values (over every boundary of a set of clips): what a

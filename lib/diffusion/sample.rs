@@ -4,11 +4,11 @@
 
 use super::schedule::{Sampler, Schedule};
 use super::DiffusionError;
-use crate::rng::gaussian;
 use crate::nn::{batch_from, BatchItem, Denoiser};
 use crate::repr::anytop::{plant_feet, AnyTopStats};
 use crate::repr::smooth::smooth_features;
 use crate::repr::Features;
+use crate::rng::gaussian;
 use crate::rng::SplitMix64;
 use candle_core::Device;
 
@@ -80,8 +80,7 @@ pub(super) fn denoise(
     let mut rng = SplitMix64::new(opts.seed);
     let mut known_rng = imposed.map(|k| SplitMix64::new(k.seed));
     let known_count = imposed.map_or(0, |k| k.known.iter().filter(|&&b| b).count());
-    let mut x: Vec<Features> =
-        (0..opts.samples).map(|_| Features { frames: opts.frames, joints, dims, data: gaussian(&mut rng, per) }).collect();
+    let mut x: Vec<Features> = (0..opts.samples).map(|_| Features { frames: opts.frames, joints, dims, data: gaussian(&mut rng, per) }).collect();
     let timesteps = schedule.timesteps(opts.steps);
     for step in schedule.steps(&timesteps, opts.sampler) {
         if let (Some(k), Some(krng)) = (imposed, known_rng.as_mut()) {

@@ -26,8 +26,7 @@ impl Schedule {
     /// The cosine schedule of `steps` steps (AnyTop: 100): β_i = min(1 − ᾱ((i+1)/T)/ᾱ(i/T), 0.999).
     pub fn cosine(steps: usize) -> Schedule {
         let t = steps.max(1) as f64;
-        let betas: Vec<f64> =
-            (0..steps.max(1)).map(|i| (1.0 - cosine_alpha_bar((i + 1) as f64 / t) / cosine_alpha_bar(i as f64 / t)).min(0.999)).collect();
+        let betas: Vec<f64> = (0..steps.max(1)).map(|i| (1.0 - cosine_alpha_bar((i + 1) as f64 / t) / cosine_alpha_bar(i as f64 / t)).min(0.999)).collect();
         Schedule::from_betas(betas)
     }
 

@@ -176,7 +176,17 @@ struct LossSums {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn loss_sums(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[Crop], steps: &[u32], rng: &mut SplitMix64, rotation: bool, velocity: bool, device: &Device) -> Result<LossSums, NnError> {
+fn loss_sums(
+    model: &Denoiser,
+    set: &TrainSet,
+    schedule: &Schedule,
+    crops: &[Crop],
+    steps: &[u32],
+    rng: &mut SplitMix64,
+    rotation: bool,
+    velocity: bool,
+    device: &Device,
+) -> Result<LossSums, NnError> {
     let features: Vec<_> = crops.iter().map(|c| set.crop(c)).collect();
     let items: Vec<BatchItem> = crops
         .iter()
@@ -452,7 +462,18 @@ mod tests {
         let b = Tensor::from_vec(vec![1.0f64, 0.0, 0.0, 0.0, 1.0, 0.0], (1, 6), &dev).unwrap();
         let a0 = [0.8f64, 0.5, 0.1, -0.4, 0.9, 0.2];
         let a = Var::from_vec(a0.to_vec(), (1, 6), &dev).unwrap();
-        let g = rotation_distance(a.as_tensor(), &b).unwrap().sum_all().unwrap().backward().unwrap().get(a.as_tensor()).unwrap().flatten_all().unwrap().to_vec1::<f64>().unwrap();
+        let g = rotation_distance(a.as_tensor(), &b)
+            .unwrap()
+            .sum_all()
+            .unwrap()
+            .backward()
+            .unwrap()
+            .get(a.as_tensor())
+            .unwrap()
+            .flatten_all()
+            .unwrap()
+            .to_vec1::<f64>()
+            .unwrap();
         let theta = |v: [f64; 6]| rotation_distance(&Tensor::from_vec(v.to_vec(), (1, 6), &dev).unwrap(), &b).unwrap().to_vec1::<f64>().unwrap()[0];
         for k in 0..6 {
             let (mut up, mut down) = (a0, a0);
@@ -486,7 +507,9 @@ mod tests {
         let set = set();
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
-        let loss = |vel: f64| training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, 1.0, vel, &dev).unwrap().to_scalar::<f32>().unwrap() as f64;
+        let loss = |vel: f64| {
+            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, 1.0, vel, &dev).unwrap().to_scalar::<f32>().unwrap() as f64
+        };
         let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
         // Same draws, so the term is linear in its weight; an untrained model's changes are off.
         assert!(one > off, "{one} vs {off}");

@@ -342,7 +342,19 @@ impl AnyTopTrainer {
 impl Trainer for AnyTopTrainer {
     fn step(&mut self, k: u64) -> Result<StepLosses, TrainError> {
         let mut rng = step_rng(self.info.seed, k);
-        let stats = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.schedule, &mut rng, self.batch, self.crop, self.lambda_geo, self.lambda_vel, &self.device)?;
+        let stats = train_step(
+            &self.model,
+            &self.vars,
+            &mut self.opt,
+            &self.set,
+            &self.schedule,
+            &mut rng,
+            self.batch,
+            self.crop,
+            self.lambda_geo,
+            self.lambda_vel,
+            &self.device,
+        )?;
         Ok(StepLosses { total: stats.loss, parts: Vec::new() })
     }
 

@@ -166,10 +166,12 @@ pub fn binding_choices(similarity: &[Vec<f64>], reference: &Skeleton, target: &S
     let (rc, tc) = (candidates(reference), candidates(target));
     let at = |t: usize, r: usize| similarity.get(t).and_then(|row| row.get(r)).copied().unwrap_or(f64::NEG_INFINITY);
     // First choice by score, ties to the lower index, so the result depends on nothing else.
-    let first = |scores: &mut dyn Iterator<Item = (usize, f64)>| scores.fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
-        Some((_, b)) if b >= s => best,
-        _ => Some((i, s)),
-    });
+    let first = |scores: &mut dyn Iterator<Item = (usize, f64)>| {
+        scores.fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
+            Some((_, b)) if b >= s => best,
+            _ => Some((i, s)),
+        })
+    };
     let mut pairs: Vec<Choice> = Vec::new();
     for &t in &tc {
         let Some((r, s)) = first(&mut rc.iter().map(|&r| (r, at(t, r)))) else { continue };

@@ -10,8 +10,8 @@
 use super::correspond::Match;
 use crate::embed::NameTable;
 use crate::motion::Motion;
-use crate::skeleton::{names, Joint, Skeleton};
 use crate::rng::SplitMix64;
+use crate::skeleton::{names, Joint, Skeleton};
 use glam::DVec3;
 
 /// `skeleton` and `motion` with the joints in another valid file order — every joint's children
@@ -42,7 +42,11 @@ pub fn renamed_shuffled(skeleton: &Skeleton, motion: &Motion, rng: &mut SplitMix
             Joint { name: new.to_string(), parent: j.parent.map(|p| new_of[p]), ..j.clone() }
         })
         .collect();
-    let moved = Motion { rotations: reorder(&motion.rotations, motion.joints, &order), translations: reorder(&motion.translations, motion.joints, &order), ..motion.clone() };
+    let moved = Motion {
+        rotations: reorder(&motion.rotations, motion.joints, &order),
+        translations: reorder(&motion.translations, motion.joints, &order),
+        ..motion.clone()
+    };
     (Skeleton { joints, frame_time: skeleton.frame_time }, moved, order)
 }
 
@@ -65,7 +69,17 @@ pub fn mirrors(skeleton: &Skeleton) -> Vec<Option<usize>> {
         if !words.iter().any(|w| *w == "Left" || *w == "Right") {
             return None;
         }
-        Some(words.iter().map(|w| match *w { "Left" => "Right", "Right" => "Left", w => w }).collect::<Vec<_>>().join(" "))
+        Some(
+            words
+                .iter()
+                .map(|w| match *w {
+                    "Left" => "Right",
+                    "Right" => "Left",
+                    w => w,
+                })
+                .collect::<Vec<_>>()
+                .join(" "),
+        )
     };
     normalised.iter().map(|n| swap(n).and_then(|m| normalised.iter().position(|o| *o == m))).collect()
 }
@@ -129,10 +143,7 @@ pub fn geometry_descriptors(rest: &[DVec3]) -> Vec<Vec<f32>> {
 /// Similarity as minus the Euclidean distance `[target][reference]` (for positions, where
 /// the cosine would tie every joint along one ray from the root).
 pub fn distance_similarity(target: &[Vec<f32>], reference: &[Vec<f32>]) -> Vec<Vec<f64>> {
-    target
-        .iter()
-        .map(|t| reference.iter().map(|r| -t.iter().zip(r).map(|(a, b)| (*a as f64 - *b as f64).powi(2)).sum::<f64>().sqrt()).collect())
-        .collect()
+    target.iter().map(|t| reference.iter().map(|r| -t.iter().zip(r).map(|(a, b)| (*a as f64 - *b as f64).powi(2)).sum::<f64>().sqrt()).collect()).collect()
 }
 
 /// A smooth time warp of a clip onto as many frames: new frame k shows source position
@@ -211,8 +222,7 @@ mod tests {
         assert_eq!((acc.correct, acc.total), (s.len(), s.len()));
         // Answering every joint with its mirror counts as left/right confusions, not correct.
         let mirror = mirrors(&s);
-        let flipped: Vec<Match> =
-            (0..c.len()).map(|t| Match { target: t, reference: mirror[order[t]].unwrap_or(order[t]), score: 1.0, margin: 0.0 }).collect();
+        let flipped: Vec<Match> = (0..c.len()).map(|t| Match { target: t, reference: mirror[order[t]].unwrap_or(order[t]), score: 1.0, margin: 0.0 }).collect();
         let acc = score_joints(&flipped, &truth, &mirror);
         let sided = mirror.iter().filter(|m| m.is_some()).count();
         assert_eq!((acc.left_right, acc.correct), (sided, s.len() - sided));

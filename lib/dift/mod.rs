@@ -16,15 +16,15 @@ pub mod eval;
 use crate::diffusion::checkpoint::CheckpointInfo;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::sample::Condition;
-use crate::rng::gaussian;
 use crate::diffusion::{DiffusionError, Schedule};
 use crate::document::AnyTopSection;
 use crate::motion::Motion;
 use crate::nn::{batch_from, BatchItem, Denoiser, NnError};
 use crate::repr::anytop::{AnyTopError, AnyTopStats};
 use crate::repr::Features;
-use crate::skeleton::Skeleton;
+use crate::rng::gaussian;
 use crate::rng::SplitMix64;
+use crate::skeleton::Skeleton;
 use candle_core::Device;
 
 /// Where and how to read the features.
@@ -191,7 +191,8 @@ pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file
     if motion.frames < 2 {
         return Err(DiftError::Invalid(format!("{file}: {} frame(s); DIFT features need a motion of at least 2 frames", motion.frames)));
     }
-    let section = AnyTopSection::of_clip(skeleton, motion, file).map_err(|source| DiftError::Repr { what: format!("{file}: cannot build an AnyTop rig"), source })?;
+    let section =
+        AnyTopSection::of_clip(skeleton, motion, file).map_err(|source| DiftError::Repr { what: format!("{file}: cannot build an AnyTop rig"), source })?;
     let features = section.rig.encode(skeleton, motion).map_err(DiftError::repr(file))?.features;
     prepare_encoded(info, skeleton, &section.rest_row, features, file)
 }
@@ -200,7 +201,8 @@ pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file
 /// `rest_row`, e.g. an NPY from `mo-encode` and its skeleton document.
 pub fn prepare_encoded(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], mut features: Features, file: &str) -> Result<Prepared, DiftError> {
     let measured = AnyTopStats::compute([&features]).map_err(DiftError::repr(file))?;
-    let condition = SkeletonCondition::with_stats(info, skeleton, rest_row, measured, StatsSource::Measured).map_err(|source| DiftError::Condition { file: file.to_string(), source })?;
+    let condition = SkeletonCondition::with_stats(info, skeleton, rest_row, measured, StatsSource::Measured)
+        .map_err(|source| DiftError::Condition { file: file.to_string(), source })?;
     condition.stats.normalise(&mut features).map_err(DiftError::repr(file))?;
     Ok(Prepared { condition, features })
 }
@@ -215,7 +217,14 @@ const TOKENS_PER_PASS: usize = 48_000;
 /// DIFT features of a normalised motion (`Prepared::features`): the mean over `opts.draws`
 /// noise draws of the activations after `opts.layer` at step `opts.t`. Deterministic for
 /// `opts.seed`; draw k always takes the same noise whatever the batching.
-pub fn extract(model: &Denoiser, schedule: &Schedule, cond: &Condition, motion: &Features, opts: &DiftOptions, device: &Device) -> Result<DiftFeatures, DiftError> {
+pub fn extract(
+    model: &Denoiser,
+    schedule: &Schedule,
+    cond: &Condition,
+    motion: &Features,
+    opts: &DiftOptions,
+    device: &Device,
+) -> Result<DiftFeatures, DiftError> {
     let cfg = model.config();
     if opts.t >= schedule.len() {
         return Err(DiftError::Invalid(format!("diffusion step {} is past the schedule's last ({})", opts.t, schedule.len().saturating_sub(1))));
@@ -259,7 +268,14 @@ pub fn extract(model: &Denoiser, schedule: &Schedule, cond: &Condition, motion: 
         let items: Vec<BatchItem> = noised
             .iter()
             .zip(&starts)
-            .map(|(f, &start)| BatchItem { features: f, rest_row: cond.rest_row, relations: cond.relations, distances: cond.distances, names: cond.names, start })
+            .map(|(f, &start)| BatchItem {
+                features: f,
+                rest_row: cond.rest_row,
+                relations: cond.relations,
+                distances: cond.distances,
+                names: cond.names,
+                start,
+            })
             .collect();
         let batch = batch_from(&items, &vec![opts.t as u32; n], device)?;
         let h: Vec<f32> = model.activations(&batch, opts.layer)?.flatten_all()?.to_vec1()?;

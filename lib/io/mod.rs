@@ -21,7 +21,11 @@ pub fn read_input(path: &Path) -> io::Result<Vec<u8>> {
 
 /// Human name of an input for messages (`<stdin>` for `-`).
 pub fn display_name(path: &Path) -> String {
-    if path.as_os_str() == "-" { "<stdin>".to_string() } else { path.display().to_string() }
+    if path.as_os_str() == "-" {
+        "<stdin>".to_string()
+    } else {
+        path.display().to_string()
+    }
 }
 
 /// Write `bytes` to `path` (see `output`), or to stdout when `path` is `-` or `None`.

@@ -12,8 +12,8 @@
 //! by the **real** set's per-dimension mean and population std. [`FidOptions::normalise`]
 //! does that (default on). Definitions and deviations: `docs/metrics.md`.
 
-use crate::linalg::{covariance, eigen_tolerance, matmul, sqrtm_psd, symmetric_eigenvalues, trace};
 use super::MetricError;
+use crate::linalg::{covariance, eigen_tolerance, matmul, sqrtm_psd, symmetric_eigenvalues, trace};
 
 /// A real-set dimension whose std is at most this fraction of max(1, |mean|) is constant:
 /// normalisation centres it but does not divide by its (zero) spread.
@@ -115,10 +115,7 @@ fn check_set(set: &str, rows: &[Vec<f64>], dims: Option<usize>) -> Result<usize,
     }
     for (i, r) in rows.iter().enumerate() {
         if r.len() != want {
-            return Err(MetricError::Mismatch(format!(
-                "FID: {set} row {i} has {} values, expected {want} (the length of real row 0)",
-                r.len()
-            )));
+            return Err(MetricError::Mismatch(format!("FID: {set} row {i} has {} values, expected {want} (the length of real row 0)", r.len())));
         }
         if let Some(j) = r.iter().position(|v| !v.is_finite()) {
             return Err(MetricError::NonFinite(format!("FID: {set} row {i} column {j} is {}", r[j])));

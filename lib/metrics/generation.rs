@@ -50,19 +50,10 @@ impl PointClip {
             return Err(MetricError::Mismatch(format!("point clip: {dims} values per frame is not a positive multiple of 3")));
         }
         if values.len() != frames * dims {
-            return Err(MetricError::Mismatch(format!(
-                "point clip: {} values for {frames} frames of {dims} (expected {})",
-                values.len(),
-                frames * dims
-            )));
+            return Err(MetricError::Mismatch(format!("point clip: {} values for {frames} frames of {dims} (expected {})", values.len(), frames * dims)));
         }
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(MetricError::NonFinite(format!(
-                "point clip: frame {} value {} is {}",
-                i / dims,
-                i % dims,
-                values[i]
-            )));
+            return Err(MetricError::NonFinite(format!("point clip: frame {} value {} is {}", i / dims, i % dims, values[i])));
         }
         Ok(PointClip { frames, dims, values })
     }
@@ -107,12 +98,7 @@ impl PointClip {
     /// root height subtracted.
     pub fn from_clip_with(clip: &Clip, features: &PointFeatures) -> Result<PointClip, MetricError> {
         if clip.positions.len() != clip.frames * clip.joints {
-            return Err(MetricError::Mismatch(format!(
-                "clip: {} positions for {} frames × {} joints",
-                clip.positions.len(),
-                clip.frames,
-                clip.joints
-            )));
+            return Err(MetricError::Mismatch(format!("clip: {} positions for {} frames × {} joints", clip.positions.len(), clip.frames, clip.joints)));
         }
         if let Some((f, j)) = clip.first_non_finite() {
             return Err(MetricError::NonFinite(format!("clip: frame {f} joint {j} has a non-finite position")));
@@ -131,14 +117,11 @@ impl PointClip {
             None if clip.frames == 0 => 1.0,
             None => {
                 let p = clip.frame(0);
-                let bones: Vec<f64> = (0..clip.joints)
-                    .filter_map(|j| clip.parents.get(j).copied().flatten().filter(|&q| q < clip.joints).map(|q| p[j].distance(p[q])))
-                    .collect();
+                let bones: Vec<f64> =
+                    (0..clip.joints).filter_map(|j| clip.parents.get(j).copied().flatten().filter(|&q| q < clip.joints).map(|q| p[j].distance(p[q]))).collect();
                 let mean = bones.iter().sum::<f64>() / bones.len().max(1) as f64;
                 if !(mean > 0.0 && mean.is_finite()) {
-                    return Err(MetricError::TooLittle(
-                        "clip: frame 0 has no bone of non-zero length to scale by (pass a scale)".to_string(),
-                    ));
+                    return Err(MetricError::TooLittle("clip: frame 0 has no bone of non-zero length to scale by (pass a scale)".to_string()));
                 }
                 HUMANML_MEAN_BONE_LENGTH / mean
             }
@@ -356,17 +339,12 @@ pub fn aggregate(reports: &[GenerationReport]) -> GenerationAggregate {
     }
 }
 
-
 /// AnyTop's generation metrics of `generated` samples against `gt` clips of one skeleton.
 ///
 /// Errors: no samples or no GT clip long enough (`TooLittle`), clips with different point
 /// counts (`Mismatch`), a sample not longer than the window, or one that no GT clip can tile
 /// with pieces of at least `min_segment` frames (`TooLittle`, naming it).
-pub fn generation_metrics(
-    generated: &[PointClip],
-    gt: &[PointClip],
-    opts: &GenerationOptions,
-) -> Result<GenerationReport, MetricError> {
+pub fn generation_metrics(generated: &[PointClip], gt: &[PointClip], opts: &GenerationOptions) -> Result<GenerationReport, MetricError> {
     let w = opts.window;
     if w == 0 || opts.min_segment == 0 || opts.reps == 0 || opts.gt_pairs == 0 {
         return Err(MetricError::Mismatch(format!(
@@ -401,10 +379,7 @@ pub fn generation_metrics(
     let kept: Vec<&PointClip> = gt.iter().filter(|c| c.frames >= opts.gt_min_frames && c.frames > w).collect();
     let gt_dropped = gt.len() - kept.len();
     if gt_dropped > 0 {
-        warnings.push(format!(
-            "{gt_dropped} GT clip(s) left out for having fewer than {} frames",
-            opts.gt_min_frames.max(w + 1)
-        ));
+        warnings.push(format!("{gt_dropped} GT clip(s) left out for having fewer than {} frames", opts.gt_min_frames.max(w + 1)));
     }
     if kept.is_empty() {
         return Err(MetricError::TooLittle(format!(
@@ -419,9 +394,7 @@ pub fn generation_metrics(
         warnings.push("generated samples differ in length (the reference requires 120 frames each)".into());
     }
     if gen_frames < 2 * gt_frames {
-        warnings.push(format!(
-            "generated frames ({gen_frames}) are fewer than twice the GT frames ({gt_frames}); the reference asserts at least twice"
-        ));
+        warnings.push(format!("generated frames ({gen_frames}) are fewer than twice the GT frames ({gt_frames}); the reference asserts at least twice"));
     }
     let per_sample = (gen_frames / generated.len()).max(1);
     let wanted_subset = opts.coverage_subset.unwrap_or(gt_frames / per_sample + 1).max(1);
@@ -432,12 +405,9 @@ pub fn generation_metrics(
 
     // Every random draw, in a fixed order: GT window pairs, sample window pairs, subsets.
     let mut rng = SplitMix64::new(opts.seed);
-    let gt_offsets: Vec<Vec<(usize, usize)>> = kept
-        .iter()
-        .map(|c| (0..opts.gt_pairs).map(|_| (rng.below(c.frames - w), rng.below(c.frames - w))).collect())
-        .collect();
-    let gen_offsets: Vec<(usize, usize)> =
-        generated.iter().map(|c| (rng.below(c.frames - w), rng.below(c.frames - w))).collect();
+    let gt_offsets: Vec<Vec<(usize, usize)>> =
+        kept.iter().map(|c| (0..opts.gt_pairs).map(|_| (rng.below(c.frames - w), rng.below(c.frames - w))).collect()).collect();
+    let gen_offsets: Vec<(usize, usize)> = generated.iter().map(|c| (rng.below(c.frames - w), rng.below(c.frames - w))).collect();
     let subsets: Vec<Vec<usize>> = (0..opts.reps)
         .map(|_| {
             let mut idx: Vec<usize> = (0..generated.len()).collect();
@@ -505,9 +475,7 @@ pub fn generation_metrics(
             let m = &cost[i];
             // Starts 0..L − w (the reference leaves the last one out).
             let windows = sums[i].chunks_exact(gt_starts_all).take(c.frames - w);
-            let local = windows.map(|row| row.iter().copied().fold(f64::INFINITY, f64::min)).sum::<f64>()
-                / (c.frames - w) as f64
-                / w as f64;
+            let local = windows.map(|row| row.iter().copied().fold(f64::INFINITY, f64::min)).sum::<f64>() / (c.frames - w) as f64 / w as f64;
             let mut best = f64::INFINITY;
             for (k, g) in kept.iter().enumerate() {
                 best = best.min(tiling_cost(m, gt_frames, c.frames, gt_starts[k], g.frames, opts.min_segment));
@@ -536,13 +504,9 @@ pub fn generation_metrics(
             average_frame_distance(a, 0, b, 0, a.frames.min(b.frames))
         })
         .collect();
-    let intra: Vec<f64> =
-        generated.iter().zip(&gen_offsets).map(|(c, &(a, b))| average_frame_distance(c, a, c, b, w)).collect();
-    let gt_intra: Vec<f64> = kept
-        .iter()
-        .zip(&gt_offsets)
-        .flat_map(|(c, pairs)| pairs.iter().map(move |&(a, b)| average_frame_distance(c, a, c, b, w)))
-        .collect();
+    let intra: Vec<f64> = generated.iter().zip(&gen_offsets).map(|(c, &(a, b))| average_frame_distance(c, a, c, b, w)).collect();
+    let gt_intra: Vec<f64> =
+        kept.iter().zip(&gt_offsets).flat_map(|(c, pairs)| pairs.iter().map(move |&(a, b)| average_frame_distance(c, a, c, b, w))).collect();
     let gt_intra_stats = MeanStd::of(&gt_intra);
     let diff: Vec<f64> = intra.iter().map(|v| (v - gt_intra_stats.mean).abs()).collect();
 

@@ -74,10 +74,7 @@ pub fn human_roles(clip: &Clip) -> Result<HumanRoles, String> {
         sides[j] = names::side_from_name(&normalised[j]).unwrap_or_else(|| clip.parents[j].map_or(Side::Centre, |p| sides[p]));
     }
     // The name without its side word: "Left Fore Arm" -> "Fore Arm".
-    let part: Vec<&str> = normalised
-        .iter()
-        .map(|s| s.strip_prefix("Left ").or_else(|| s.strip_prefix("Right ")).unwrap_or(s.as_str()))
-        .collect();
+    let part: Vec<&str> = normalised.iter().map(|s| s.strip_prefix("Left ").or_else(|| s.strip_prefix("Right ")).unwrap_or(s.as_str())).collect();
     let children = {
         let mut c = vec![Vec::new(); n];
         for (j, p) in clip.parents.iter().enumerate() {
@@ -102,9 +99,7 @@ pub fn human_roles(clip: &Clip) -> Result<HumanRoles, String> {
                 return Ok(j);
             }
         }
-        children[from].first().copied().ok_or_else(|| {
-            format!("no {} {role}: joint '{}' has no child joint", side_word(s), clip.names[from])
-        })
+        children[from].first().copied().ok_or_else(|| format!("no {} {role}: joint '{}' has no child joint", side_word(s), clip.names[from]))
     };
     let parent = |j: usize, role: &str, s: Side| -> Result<usize, String> {
         clip.parents[j].ok_or_else(|| format!("no {} {role}: '{}' is the root", side_word(s), clip.names[j]))
@@ -138,9 +133,10 @@ pub fn human_roles(clip: &Clip) -> Result<HumanRoles, String> {
     let chest = lca(ls, rs).ok_or("no chest: the two shoulders are in different trees")?;
     // Path chest -> root; the belly is the joint on it just above the root.
     let path = ancestors(chest);
-    let at = path.iter().position(|&j| j == root).ok_or_else(|| {
-        format!("no spine: the arms branch at '{}', which is not above the pelvis '{}'", clip.names[chest], clip.names[root])
-    })?;
+    let at = path
+        .iter()
+        .position(|&j| j == root)
+        .ok_or_else(|| format!("no spine: the arms branch at '{}', which is not above the pelvis '{}'", clip.names[chest], clip.names[root]))?;
     if at == 0 {
         return Err(format!("no spine: the arms and legs branch at the same joint '{}'", clip.names[root]));
     }
@@ -458,9 +454,7 @@ pub fn geometric_features(clip: &Clip, roles: &HumanRoles, opts: &GeometricOptio
         for (k, rel) in FEATURES.iter().enumerate() {
             let holds = match *rel {
                 Move(a, b, c, t) => unit(now(b) - now(a)).is_some_and(|d| relative_velocity(c, a).dot(d) > threshold(t)),
-                NMove(a, b, c, d, t) => {
-                    unit((now(c) - now(a)).cross(now(b) - now(a))).is_some_and(|n| relative_velocity(d, a).dot(n) > threshold(t))
-                }
+                NMove(a, b, c, d, t) => unit((now(c) - now(a)).cross(now(b) - now(a))).is_some_and(|n| relative_velocity(d, a).dot(n) > threshold(t)),
                 Plane(a, b, c, d, t) => unit((now(c) - now(a)).cross(now(b) - now(a))).is_some_and(|n| (now(d) - now(a)).dot(n) > threshold(t)),
                 NPlane(a, b, c, d, t) => unit(now(b) - now(a)).is_some_and(|n| (now(d) - now(c)).dot(n) > threshold(t)),
                 Angle(a, b, c, d, lo, hi) => match (unit(now(b) - now(a)), unit(now(d) - now(c))) {
@@ -508,27 +502,27 @@ mod tests {
     fn skeleton_joints() -> Vec<(&'static str, Option<usize>, DVec3)> {
         // name, parent, rest position (metres)
         vec![
-            ("Hips", None, DVec3::new(0.0, 1.0, 0.0)),                     // 0
-            ("LeftUpLeg", Some(0), DVec3::new(0.1, 0.95, 0.0)),            // 1
-            ("LeftLeg", Some(1), DVec3::new(0.1, 0.5, 0.0)),               // 2
-            ("LeftFoot", Some(2), DVec3::new(0.1, 0.08, 0.0)),             // 3
-            ("LeftToeBase", Some(3), DVec3::new(0.1, 0.0, 0.12)),          // 4
-            ("RightUpLeg", Some(0), DVec3::new(-0.1, 0.95, 0.0)),          // 5
-            ("RightLeg", Some(5), DVec3::new(-0.1, 0.5, 0.0)),             // 6
-            ("RightFoot", Some(6), DVec3::new(-0.1, 0.08, 0.0)),           // 7
-            ("RightToeBase", Some(7), DVec3::new(-0.1, 0.0, 0.12)),        // 8
-            ("Spine", Some(0), DVec3::new(0.0, 1.15, 0.0)),                // 9
-            ("Spine1", Some(9), DVec3::new(0.0, 1.35, 0.0)),               // 10
-            ("Neck", Some(10), DVec3::new(0.0, 1.5, 0.0)),                 // 11
-            ("Head", Some(11), DVec3::new(0.0, 1.65, 0.0)),                // 12
-            ("LeftShoulder", Some(10), DVec3::new(0.08, 1.45, 0.0)),       // 13
-            ("LeftArm", Some(13), DVec3::new(0.2, 1.45, 0.0)),             // 14
-            ("LeftForeArm", Some(14), DVec3::new(0.45, 1.45, 0.0)),        // 15
-            ("LeftHand", Some(15), DVec3::new(0.7, 1.45, 0.0)),            // 16
-            ("RightShoulder", Some(10), DVec3::new(-0.08, 1.45, 0.0)),     // 17
-            ("RightArm", Some(17), DVec3::new(-0.2, 1.45, 0.0)),           // 18
-            ("RightForeArm", Some(18), DVec3::new(-0.45, 1.45, 0.0)),      // 19
-            ("RightHand", Some(19), DVec3::new(-0.7, 1.45, 0.0)),          // 20
+            ("Hips", None, DVec3::new(0.0, 1.0, 0.0)),                 // 0
+            ("LeftUpLeg", Some(0), DVec3::new(0.1, 0.95, 0.0)),        // 1
+            ("LeftLeg", Some(1), DVec3::new(0.1, 0.5, 0.0)),           // 2
+            ("LeftFoot", Some(2), DVec3::new(0.1, 0.08, 0.0)),         // 3
+            ("LeftToeBase", Some(3), DVec3::new(0.1, 0.0, 0.12)),      // 4
+            ("RightUpLeg", Some(0), DVec3::new(-0.1, 0.95, 0.0)),      // 5
+            ("RightLeg", Some(5), DVec3::new(-0.1, 0.5, 0.0)),         // 6
+            ("RightFoot", Some(6), DVec3::new(-0.1, 0.08, 0.0)),       // 7
+            ("RightToeBase", Some(7), DVec3::new(-0.1, 0.0, 0.12)),    // 8
+            ("Spine", Some(0), DVec3::new(0.0, 1.15, 0.0)),            // 9
+            ("Spine1", Some(9), DVec3::new(0.0, 1.35, 0.0)),           // 10
+            ("Neck", Some(10), DVec3::new(0.0, 1.5, 0.0)),             // 11
+            ("Head", Some(11), DVec3::new(0.0, 1.65, 0.0)),            // 12
+            ("LeftShoulder", Some(10), DVec3::new(0.08, 1.45, 0.0)),   // 13
+            ("LeftArm", Some(13), DVec3::new(0.2, 1.45, 0.0)),         // 14
+            ("LeftForeArm", Some(14), DVec3::new(0.45, 1.45, 0.0)),    // 15
+            ("LeftHand", Some(15), DVec3::new(0.7, 1.45, 0.0)),        // 16
+            ("RightShoulder", Some(10), DVec3::new(-0.08, 1.45, 0.0)), // 17
+            ("RightArm", Some(17), DVec3::new(-0.2, 1.45, 0.0)),       // 18
+            ("RightForeArm", Some(18), DVec3::new(-0.45, 1.45, 0.0)),  // 19
+            ("RightHand", Some(19), DVec3::new(-0.7, 1.45, 0.0)),      // 20
         ]
     }
 
@@ -541,10 +535,7 @@ mod tests {
         let clip = human(&[rest_pose()], 30.0);
         let r = human_roles(&clip).unwrap();
         let name = |j: usize| clip.names[j].as_str();
-        assert_eq!(
-            [r.root, r.belly, r.chest, r.neck].map(name),
-            ["Hips", "Spine", "Spine1", "Neck"]
-        );
+        assert_eq!([r.root, r.belly, r.chest, r.neck].map(name), ["Hips", "Spine", "Spine1", "Neck"]);
         assert_eq!([r.left_hip, r.left_knee, r.left_ankle, r.left_toes].map(name), ["LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase"]);
         assert_eq!([r.right_shoulder, r.right_elbow, r.right_wrist].map(name), ["RightArm", "RightForeArm", "RightHand"]);
     }

@@ -50,7 +50,13 @@ pub struct MovementOptions {
 
 impl Default for MovementOptions {
     fn default() -> Self {
-        MovementOptions { smooth_frames: 5, window: 15, max_reference_frames: 4000, max_windows: 2000, contact: PhysicsOptions { ground: Ground::Estimate, ..PhysicsOptions::default() } }
+        MovementOptions {
+            smooth_frames: 5,
+            window: 15,
+            max_reference_frames: 4000,
+            max_windows: 2000,
+            contact: PhysicsOptions { ground: Ground::Estimate, ..PhysicsOptions::default() },
+        }
     }
 }
 
@@ -124,10 +130,8 @@ pub fn energy(clip: &Clip, smooth: usize) -> f64 {
         return 0.0;
     }
     let rel = |f: usize, j: usize| clip.at(f, j) - clip.at(f, 0);
-    let averaged: Vec<DVec3> = (0..=frames - k)
-        .flat_map(|f| (0..joints).map(move |j| (f, j)))
-        .map(|(f, j)| (0..k).map(|t| rel(f + t, j)).sum::<DVec3>() / k as f64)
-        .collect();
+    let averaged: Vec<DVec3> =
+        (0..=frames - k).flat_map(|f| (0..joints).map(move |j| (f, j))).map(|(f, j)| (0..k).map(|t| rel(f + t, j)).sum::<DVec3>() / k as f64).collect();
     let steps = frames - k;
     let mut total = 0.0;
     for f in 0..steps {
@@ -357,7 +361,10 @@ impl<'a> Reference<'a> {
         Ok(Movement {
             energy: self.energy,
             energy_ratio: 1.0,
-            energy_ratio_range: (ratio(energies.iter().copied().fold(f64::INFINITY, f64::min)), ratio(energies.iter().copied().fold(f64::NEG_INFINITY, f64::max))),
+            energy_ratio_range: (
+                ratio(energies.iter().copied().fold(f64::INFINITY, f64::min)),
+                ratio(energies.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
+            ),
             nearest_pose: parts.iter().zip(&weights).map(|(p, w)| p.0 * w).sum::<f64>() / total,
             calibrated_coverage: self.coverage_leave_one_out(),
             duty_factor: avg_opt(&|p| p.1),
@@ -419,7 +426,8 @@ impl<'a> Reference<'a> {
             let joints = clip.joints;
             world.push(Clip { frames: len, positions: clip.positions[start * joints..(start + len) * joints].to_vec(), ..clip.clone() });
             let dims = point.dims();
-            points.push(PointClip::new(len, dims, point.values()[start * dims..(start + len) * dims].to_vec()).expect("a crop of a point clip is a point clip"));
+            points
+                .push(PointClip::new(len, dims, point.values()[start * dims..(start + len) * dims].to_vec()).expect("a crop of a point clip is a point clip"));
         }
         (world, points)
     }

@@ -379,16 +379,7 @@ pub(crate) mod tests {
             positions.push(foot(f) + DVec3::Y);
             positions.push(foot(f));
         }
-        Clip {
-            frames,
-            joints: 2,
-            fps,
-            positions,
-            parents: vec![None, Some(0)],
-            names: vec!["Hips".into(), "LeftFoot".into()],
-            feet: vec![1],
-            scale: 1.0,
-        }
+        Clip { frames, joints: 2, fps, positions, parents: vec![None, Some(0)], names: vec!["Hips".into(), "LeftFoot".into()], feet: vec![1], scale: 1.0 }
     }
 
     #[test]

@@ -94,10 +94,7 @@ fn check_rotations(r: &Rotations, frames: usize, joints: usize) -> Result<(), Me
     let want = frames * joints;
     for (what, q) in [("reference", r.reference), ("result", r.result)] {
         if q.len() != want {
-            return Err(MetricError::Mismatch(format!(
-                "JR: the {what} has {} rotations, expected {frames} frames x {joints} joints = {want}",
-                q.len()
-            )));
+            return Err(MetricError::Mismatch(format!("JR: the {what} has {} rotations, expected {frames} frames x {joints} joints = {want}", q.len())));
         }
         if let Some(i) = q.iter().position(|q| !q.is_finite() || q.length_squared() < 1e-24) {
             return Err(MetricError::NonFinite(format!(

@@ -112,17 +112,9 @@ pub fn frequency_alignment(source: &Clip, result: &Clip, pairs: &[(usize, usize)
         return Err(MetricError::TooLittle("frequency alignment: the clips are too short to share a frequency bin".into()));
     }
     let freqs: Vec<f64> = (1..=bins).map(|k| k as f64 * resolution).collect();
-    let per_pair: Vec<f64> = pairs
-        .iter()
-        .map(|&(s, r)| cosine(&psd(&velocities(source, s), source.fps, &freqs), &psd(&velocities(result, r), result.fps, &freqs)))
-        .collect();
-    Ok(FrequencyAlignment {
-        value: per_pair.iter().sum::<f64>() / per_pair.len() as f64,
-        per_pair,
-        bins,
-        resolution_hz: resolution,
-        max_hz: freqs[bins - 1],
-    })
+    let per_pair: Vec<f64> =
+        pairs.iter().map(|&(s, r)| cosine(&psd(&velocities(source, s), source.fps, &freqs), &psd(&velocities(result, r), result.fps, &freqs))).collect();
+    Ok(FrequencyAlignment { value: per_pair.iter().sum::<f64>() / per_pair.len() as f64, per_pair, bins, resolution_hz: resolution, max_hz: freqs[bins - 1] })
 }
 
 /// Joints in the subtree of `j` (itself included).
@@ -148,12 +140,7 @@ fn subtree(clip: &Clip, j: usize) -> Vec<bool> {
 /// foot below the joint is in contact" (`physics::contacts`); result frame f is compared with
 /// source frame round(f x (source frames - 1) / (result frames - 1)), so clips of different
 /// lengths compare at the same phase. `NotApplicable` when no pair reaches feet on both sides.
-pub fn contact_consistency(
-    source: &Clip,
-    result: &Clip,
-    pairs: &[(usize, usize)],
-    opts: &PhysicsOptions,
-) -> Result<Maybe<ContactConsistency>, MetricError> {
+pub fn contact_consistency(source: &Clip, result: &Clip, pairs: &[(usize, usize)], opts: &PhysicsOptions) -> Result<Maybe<ContactConsistency>, MetricError> {
     check_clip(source, 2, "contact consistency (source)")?;
     check_clip(result, 2, "contact consistency (result)")?;
     check_pairs(source, result, pairs, "contact consistency")?;
@@ -187,12 +174,7 @@ pub fn contact_consistency(
             result.feet.len()
         )));
     }
-    Ok(Maybe::Value(ContactConsistency {
-        value: per_pair.iter().sum::<f64>() / per_pair.len() as f64,
-        pairs: counted,
-        per_pair,
-        frames: result.frames,
-    }))
+    Ok(Maybe::Value(ContactConsistency { value: per_pair.iter().sum::<f64>() / per_pair.len() as f64, pairs: counted, per_pair, frames: result.frames }))
 }
 
 /// Motion ratio: how much the result moves next to its source, per bound pair the RMS speed of

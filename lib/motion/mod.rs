@@ -107,7 +107,13 @@ impl Motion {
     /// time warps are this with different positions.
     pub fn interpolate(&self, at: &[f64]) -> Motion {
         let j = self.joints;
-        let mut out = Motion { frames: at.len(), joints: j, frame_time: self.frame_time, rotations: Vec::with_capacity(at.len() * j), translations: Vec::with_capacity(at.len() * j) };
+        let mut out = Motion {
+            frames: at.len(),
+            joints: j,
+            frame_time: self.frame_time,
+            rotations: Vec::with_capacity(at.len() * j),
+            translations: Vec::with_capacity(at.len() * j),
+        };
         if self.frames == 0 {
             out.frames = 0;
             return out;

@@ -49,7 +49,11 @@ pub fn decompose(q: DQuat, order: &[usize]) -> Vec<f64> {
 
 fn wrap_degrees(a: f64) -> f64 {
     let w = (a + 180.0).rem_euclid(360.0) - 180.0;
-    if w == -180.0 { 180.0 } else { w }
+    if w == -180.0 {
+        180.0
+    } else {
+        w
+    }
 }
 
 /// R = Ri(a) * Rj(b) * Rk(c) for distinct axes i, j, k.
@@ -106,14 +110,7 @@ mod tests {
     #[test]
     fn decompose_inverts_compose_for_every_order_including_gimbal_lock() {
         let orders = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
-        let angles = [
-            [10.0, 20.0, 30.0],
-            [-170.0, 89.0, 45.0],
-            [0.0, 90.0, 0.0],
-            [30.0, -90.0, 10.0],
-            [120.0, 5.0, -135.0],
-            [0.0, 0.0, 0.0],
-        ];
+        let angles = [[10.0, 20.0, 30.0], [-170.0, 89.0, 45.0], [0.0, 90.0, 0.0], [30.0, -90.0, 10.0], [120.0, 5.0, -135.0], [0.0, 0.0, 0.0]];
         for order in orders {
             for a in angles {
                 let q = compose(&order, &a);

@@ -26,10 +26,10 @@
 use super::config::{DenoiserConfig, RELATION_TYPES};
 use super::fused::{self, Groups, Keys};
 use super::layers::{sinusoid, FeedForward, LayerNorm, Linear};
-use std::sync::Arc;
 use super::{Batch, NnError};
 use candle_core::{DType, Tensor, D};
 use candle_nn::{Init, VarBuilder};
+use std::sync::Arc;
 
 /// Per-forward masks shared by all layers.
 struct Context {
@@ -272,8 +272,7 @@ impl Denoiser {
         let motion = self.motion_in.forward(&x.narrow(1, 1, t - 1)?)?;
         let names = zero_where_masked(&batch.names, &batch.joint_mask.unsqueeze(2)?)?;
         let h = Tensor::cat(&[rest, motion], 1)?;
-        let mut h = fused::add_broadcast(&h, &self.names_in.forward(&names)?, b)?
-            .broadcast_add(&sinusoid(&batch.positions, self.cfg.width)?.unsqueeze(2)?)?;
+        let mut h = fused::add_broadcast(&h, &self.names_in.forward(&names)?, b)?.broadcast_add(&sinusoid(&batch.positions, self.cfg.width)?.unsqueeze(2)?)?;
         let temb = sinusoid(&batch.timesteps.to_dtype(DType::F32)?, self.cfg.width)?.reshape((b, 1, 1, self.cfg.width))?;
         let bias_projection = self.bias_projection()?;
         for (l, layer) in self.layers.iter().take(layers).enumerate() {
@@ -316,7 +315,8 @@ impl Denoiser {
             .zip(&rel)
             .map(|(&d, &r)| [d.min(dmax as u32) as u16, if (r as usize) < RELATION_TYPES { (dmax + 1) as u16 + r as u16 } else { fused::NO_TYPE }])
             .collect();
-        let real = |m: &Tensor| -> candle_core::Result<Vec<bool>> { Ok(m.to_dtype(DType::F32)?.flatten_all()?.to_vec1::<f32>()?.iter().map(|&v| v != 0.0).collect()) };
+        let real =
+            |m: &Tensor| -> candle_core::Result<Vec<bool>> { Ok(m.to_dtype(DType::F32)?.flatten_all()?.to_vec1::<f32>()?.iter().map(|&v| v != 0.0).collect()) };
         let skeletal = Keys::Topology { types: Arc::new(types), key_ok: Arc::new(real(&batch.joint_mask)?), type_count: dmax + 1 + RELATION_TYPES };
         let temporal = Keys::Window { half: self.cfg.window / 2, frame_ok: Arc::new(real(&batch.frame_mask)?) };
         Ok(Context { b, t, j, skeletal, temporal })
@@ -343,7 +343,11 @@ impl Denoiser {
         };
         let scale = 1.0 / (dh as f64).sqrt();
         let projection = Tensor::cat(
-            &[per_head(&self.distance_query, &self.relation_query)?, per_head(&self.distance_key, &self.relation_key)?, Tensor::zeros((d, h * types), DType::F32, dev)?],
+            &[
+                per_head(&self.distance_query, &self.relation_query)?,
+                per_head(&self.distance_key, &self.relation_key)?,
+                Tensor::zeros((d, h * types), DType::F32, dev)?,
+            ],
             0,
         )?;
         projection * scale

@@ -37,18 +37,7 @@ impl DenoiserConfig {
     /// The reference model (anytop.md §2.1): width 128, 4 layers, 4 heads, ff 1024, W 31,
     /// d_max 5; names are 384-d MiniLM embeddings instead of 768-d T5.
     pub fn paper() -> DenoiserConfig {
-        DenoiserConfig {
-            width: 128,
-            layers: 4,
-            heads: 4,
-            ff: 1024,
-            window: 31,
-            dmax: 5,
-            name_dim: 384,
-            feature_dims: 13,
-            dropout: 0.0,
-            ln_eps: 1e-5,
-        }
+        DenoiserConfig { width: 128, layers: 4, heads: 4, ff: 1024, window: 31, dmax: 5, name_dim: 384, feature_dims: 13, dropout: 0.0, ln_eps: 1e-5 }
     }
 
     /// Half the width, a quarter of the feed-forward: about 8x fewer FLOPs per token than `paper`.

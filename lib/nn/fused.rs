@@ -528,9 +528,8 @@ impl CustomOp2 for Attention {
     }
 
     fn bwd(&self, qkv: &Tensor, c: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>)> {
-        let (d, dc) = with_values(qkv, "q/k/v", |q| {
-            with_values(c, "bias coefficients", |cv| with_values(grad, "output gradient", |g| self.backward(q, Some(cv), g)))
-        })?;
+        let (d, dc) =
+            with_values(qkv, "q/k/v", |q| with_values(c, "bias coefficients", |cv| with_values(grad, "output gradient", |g| self.backward(q, Some(cv), g))))?;
         let dc = dc.map(|v| Tensor::from_vec(v, c.shape(), c.device())).transpose()?;
         Ok((Some(Tensor::from_vec(d, qkv.shape(), qkv.device())?), dc))
     }
@@ -595,7 +594,9 @@ impl CustomOp3 for LayerNormOp {
     }
 
     fn bwd(&self, x: &Tensor, w: &Tensor, b: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        with_values(x, "layer norm input", |xv| with_values(w, "layer norm weight", |wv| with_values(grad, "layer norm output gradient", |dy| self.backward(x, w, b, xv, wv, dy))))
+        with_values(x, "layer norm input", |xv| {
+            with_values(w, "layer norm weight", |wv| with_values(grad, "layer norm output gradient", |dy| self.backward(x, w, b, xv, wv, dy)))
+        })
     }
 }
 

@@ -45,7 +45,8 @@ fn skeletal_attention_matches_basic_ops() {
     let fused = attention(qkv.as_tensor(), Some(c.as_tensor()), Groups::joints(b, t, j), h, keys).unwrap();
 
     // Reference: heads split, bias through a one-hot, additive key mask, softmax, merge.
-    let split = |part: usize| qkv.as_tensor().narrow(1, part * w, w).unwrap().reshape((b * t, j, h, dh)).unwrap().transpose(1, 2).unwrap().contiguous().unwrap();
+    let split =
+        |part: usize| qkv.as_tensor().narrow(1, part * w, w).unwrap().reshape((b * t, j, h, dh)).unwrap().transpose(1, 2).unwrap().contiguous().unwrap();
     let (q, k, v) = (split(0), split(1), split(2));
     let mut onehot = vec![0f32; b * j * nt * j];
     for s in 0..b {
@@ -101,7 +102,9 @@ fn temporal_attention_case(t: usize, half: usize) {
     let keys = Keys::Window { half, frame_ok: Arc::new(frame_ok.clone()) };
     let fused = attention(qkv.as_tensor(), None, Groups::frames(b, t, j), h, keys).unwrap();
 
-    let split = |part: usize| qkv.as_tensor().narrow(1, part * w, w).unwrap().reshape((b, t, j, h, dh)).unwrap().permute((0, 2, 3, 1, 4)).unwrap().contiguous().unwrap();
+    let split = |part: usize| {
+        qkv.as_tensor().narrow(1, part * w, w).unwrap().reshape((b, t, j, h, dh)).unwrap().permute((0, 2, 3, 1, 4)).unwrap().contiguous().unwrap()
+    };
     let (q, k, v) = (split(0), split(1), split(2)); // [B, J, H, T, dh]
     let mut mask = vec![0f32; b * t * t];
     for s in 0..b {
@@ -118,7 +121,8 @@ fn temporal_attention_case(t: usize, half: usize) {
     let (q, k, v) = (four(&q), four(&k), four(&v));
     let logits = (q.matmul(&k.t().unwrap()).unwrap() * (1.0 / (dh as f64).sqrt())).unwrap().reshape((b, j, h, t, t)).unwrap();
     let p = softmax(&logits.broadcast_add(&mask).unwrap()).unwrap().reshape((b * j, h, t, t)).unwrap();
-    let reference = p.matmul(&v).unwrap().reshape((b, j, h, t, dh)).unwrap().permute((0, 3, 1, 2, 4)).unwrap().contiguous().unwrap().reshape((rows, w)).unwrap();
+    let reference =
+        p.matmul(&v).unwrap().reshape((b, j, h, t, dh)).unwrap().permute((0, 3, 1, 2, 4)).unwrap().contiguous().unwrap().reshape((rows, w)).unwrap();
 
     assert!(max_diff(&fused, &reference) < 1e-5, "forward differs by {}", max_diff(&fused, &reference));
     let gf = weighted_sum(&fused, 2).backward().unwrap();
@@ -138,13 +142,8 @@ fn layer_norm_matches_basic_ops() {
     let xt = x.as_tensor();
     let centred = xt.broadcast_sub(&xt.mean_keepdim(D::Minus1).unwrap()).unwrap();
     let var = centred.sqr().unwrap().mean_keepdim(D::Minus1).unwrap();
-    let reference = centred
-        .broadcast_div(&(var + 1e-5).unwrap().sqrt().unwrap())
-        .unwrap()
-        .broadcast_mul(wt.as_tensor())
-        .unwrap()
-        .broadcast_add(bs.as_tensor())
-        .unwrap();
+    let reference =
+        centred.broadcast_div(&(var + 1e-5).unwrap().sqrt().unwrap()).unwrap().broadcast_mul(wt.as_tensor()).unwrap().broadcast_add(bs.as_tensor()).unwrap();
     assert_eq!(fused.dims(), &[2, 3, 8]);
     assert!(max_diff(&fused, &reference) < 1e-5);
     let gf = weighted_sum(&fused, 1).backward().unwrap();

@@ -13,9 +13,9 @@
 pub mod anytop;
 pub mod batch;
 pub mod config;
-pub mod init;
 pub mod fused;
 pub mod gelu;
+pub mod init;
 pub mod layers;
 
 #[cfg(test)]

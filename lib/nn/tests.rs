@@ -38,7 +38,11 @@ fn topology(parents: &[Option<usize>], dmax: u8) -> (Vec<Vec<u8>>, Vec<Vec<u8>>)
         let leaf = !parents.contains(&Some(i));
         for j in 0..n {
             r[i][j] = if i == j {
-                if leaf { 5 } else { 0 }
+                if leaf {
+                    5
+                } else {
+                    0
+                }
             } else if parents[j] == Some(i) {
                 2
             } else if parents[i] == Some(j) {

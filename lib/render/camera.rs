@@ -235,11 +235,7 @@ impl Camera {
         let scale = if scale.is_finite() && scale > 0.0 { scale } else { 1.0 };
         let cx = margin as f32 + avail_w * 0.5 - scale * (xlo + xhi) * 0.5;
         // Side-like views stand on the bottom margin; the top view is centred.
-        let cy = if ground.is_some() {
-            height as f32 - margin as f32 + scale * ylo
-        } else {
-            margin as f32 + avail_h * 0.5 + scale * (ylo + yhi) * 0.5
-        };
+        let cy = if ground.is_some() { height as f32 - margin as f32 + scale * ylo } else { margin as f32 + avail_h * 0.5 + scale * (ylo + yhi) * 0.5 };
         Camera { right, up, scale, cx, cy, shift, lift, ground }
     }
 

@@ -77,8 +77,7 @@ pub fn render_html(tracks: &[Track], legend: &Legend, opts: &HtmlOptions) -> Res
     }
     // Level 9: the page is written once and read many times; 3.5 MB compress in well under a second.
     let packed = miniz_oxide::deflate::compress_to_vec_zlib(&raw, 9);
-    let legend_json: Vec<Value> =
-        legend.labels.iter().enumerate().map(|(i, name)| json!({"name": name, "colour": hex(palette(i))})).collect();
+    let legend_json: Vec<Value> = legend.labels.iter().enumerate().map(|(i, name)| json!({"name": name, "colour": hex(palette(i))})).collect();
     let meta = json!({
         "title": opts.title,
         "speed": opts.speed,
@@ -119,12 +118,7 @@ fn validate(tracks: &[Track], legend: &Legend) -> Result<(), RenderError> {
             )));
         }
         if t.positions.len() != t.frames * n {
-            return Err(RenderError::Invalid(format!(
-                "{name}: {} positions, expected {} frames x {n} points = {}",
-                t.positions.len(),
-                t.frames,
-                t.frames * n
-            )));
+            return Err(RenderError::Invalid(format!("{name}: {} positions, expected {} frames x {n} points = {}", t.positions.len(), t.frames, t.frames * n)));
         }
         if let Some((p, q)) = t.parents.iter().enumerate().find_map(|(p, q)| q.filter(|&q| q >= n).map(|q| (p, q))) {
             return Err(RenderError::Invalid(format!("{name}: point {p} has parent {q}, but there are only {n} points")));
@@ -400,8 +394,7 @@ mod tests {
     fn synthetic(frames: usize, points: usize, seed: u64) -> Track {
         let mut rng = SplitMix64::new(seed);
         let parents: Vec<Option<usize>> = (0..points).map(|p| if p == 0 { None } else { Some((p - 1) / 3) }).collect();
-        let swing: Vec<[f64; 6]> =
-            (0..points).map(|_| std::array::from_fn(|i| if i < 3 { rng.range(0.02, 0.15) } else { rng.range(0.4, 1.6) })).collect();
+        let swing: Vec<[f64; 6]> = (0..points).map(|_| std::array::from_fn(|i| if i < 3 { rng.range(0.02, 0.15) } else { rng.range(0.4, 1.6) })).collect();
         let rest: Vec<[f64; 3]> = (0..points).map(|_| [rng.range(-0.4, 0.4), rng.range(0.0, 1.8), rng.range(-0.3, 0.3)]).collect();
         let fps = 30.0;
         let mut positions = Vec::with_capacity(frames * points);
@@ -411,10 +404,7 @@ mod tests {
             for p in 0..points {
                 let v: [f64; 3] = std::array::from_fn(|a| {
                     let centre = [cx, 0.0, cz][a];
-                    centre
-                        + rest[p][a]
-                        + swing[p][a] * (swing[p][a + 3] * std::f64::consts::TAU * t + p as f64).sin()
-                        + rng.range(-5e-4, 5e-4)
+                    centre + rest[p][a] + swing[p][a] * (swing[p][a + 3] * std::f64::consts::TAU * t + p as f64).sin() + rng.range(-5e-4, 5e-4)
                 });
                 positions.push(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32));
             }

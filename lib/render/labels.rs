@@ -53,20 +53,14 @@ impl JointLabels {
         };
         match value {
             Value::Object(o) => {
-                let pairs = o
-                    .iter()
-                    .map(|(k, v)| Ok((k.clone(), label_text(v, file, &format!("joint '{k}'"))?)))
-                    .collect::<Result<Vec<_>, RenderError>>()?;
+                let pairs = o.iter().map(|(k, v)| Ok((k.clone(), label_text(v, file, &format!("joint '{k}'"))?))).collect::<Result<Vec<_>, RenderError>>()?;
                 Ok(JointLabels::ByName(pairs))
             }
             Value::Array(a) => {
-                let labels =
-                    a.iter().enumerate().map(|(i, v)| label_text(v, file, &format!("entry {i}"))).collect::<Result<Vec<_>, _>>()?;
+                let labels = a.iter().enumerate().map(|(i, v)| label_text(v, file, &format!("entry {i}"))).collect::<Result<Vec<_>, _>>()?;
                 Ok(JointLabels::ByIndex(labels))
             }
-            _ => Err(RenderError::Invalid(format!(
-                "{file}: joint labels must be an object {{\"JointName\": \"label\"}} or a list with one label per joint"
-            ))),
+            _ => Err(RenderError::Invalid(format!("{file}: joint labels must be an object {{\"JointName\": \"label\"}} or a list with one label per joint"))),
         }
     }
 }
@@ -86,9 +80,10 @@ impl FrameLabels {
                     let mut out = Vec::with_capacity(segments.len());
                     for (i, s) in segments.iter().enumerate() {
                         let bound = |key: &str| {
-                            s.get(key).and_then(Value::as_u64).map(|v| v as usize).ok_or_else(|| {
-                                RenderError::Invalid(format!("{file}: segment {i}: '{key}' must be a frame number (a non-negative integer)"))
-                            })
+                            s.get(key)
+                                .and_then(Value::as_u64)
+                                .map(|v| v as usize)
+                                .ok_or_else(|| RenderError::Invalid(format!("{file}: segment {i}: '{key}' must be a frame number (a non-negative integer)")))
                         };
                         let (start, end) = (bound("start")?, bound("end")?);
                         if end < start {

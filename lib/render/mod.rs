@@ -49,8 +49,7 @@ impl Track {
     pub fn from_motion(title: &str, skeleton: &Skeleton, motion: &Motion) -> Track {
         let pose = motion.forward_kinematics(skeleton);
         // End Site offsets are in their joint's frame.
-        let ends: Vec<(usize, DVec3)> =
-            skeleton.joints.iter().enumerate().flat_map(|(j, joint)| joint.end_sites.iter().map(move |&e| (j, e))).collect();
+        let ends: Vec<(usize, DVec3)> = skeleton.joints.iter().enumerate().flat_map(|(j, joint)| joint.end_sites.iter().map(move |&e| (j, e))).collect();
         let nj = skeleton.len();
         let points = nj + ends.len();
         let mut names: Vec<String> = skeleton.joints.iter().map(|j| j.name.clone()).collect();
@@ -192,10 +191,7 @@ pub fn check(tracks: &[Track], legend: &Legend) -> Result<(), RenderError> {
         }
         if let Some(i) = t.positions.iter().position(|p| !p.is_finite()) {
             let (f, p) = (i / n, i % n);
-            return Err(RenderError::NonFinite(format!(
-                "{title}: frame {f}, point '{}': position {} is not finite",
-                t.names[p], t.positions[i]
-            )));
+            return Err(RenderError::NonFinite(format!("{title}: frame {f}, point '{}': position {} is not finite", t.names[p], t.positions[i])));
         }
         let labels = legend.labels.len();
         for (what, list, expected) in [("point", &t.point_labels, n), ("frame", &t.frame_labels, t.frames)] {
@@ -204,9 +200,7 @@ pub fn check(tracks: &[Track], legend: &Legend) -> Result<(), RenderError> {
                 return Err(RenderError::Invalid(format!("{title}: {} {what} labels for {expected} {what}s", list.len())));
             }
             if let Some((k, l)) = list.iter().enumerate().find_map(|(k, l)| l.filter(|&l| l >= labels).map(|l| (k, l))) {
-                return Err(RenderError::Invalid(format!(
-                    "{title}: {what} {k} has label {l}, but the legend has {labels} labels"
-                )));
+                return Err(RenderError::Invalid(format!("{title}: {what} {k} has label {l}, but the legend has {labels} labels")));
             }
         }
     }

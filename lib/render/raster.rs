@@ -145,8 +145,7 @@ impl Canvas {
             return;
         }
         let reach = r + 1.0;
-        let Some((x0, y0, x1, y1)) = self.bounds(a.0.min(b.0) - reach, a.1.min(b.1) - reach, a.0.max(b.0) + reach, a.1.max(b.1) + reach)
-        else {
+        let Some((x0, y0, x1, y1)) = self.bounds(a.0.min(b.0) - reach, a.1.min(b.1) - reach, a.0.max(b.0) + reach, a.1.max(b.1) + reach) else {
             return;
         };
         let len = len2.sqrt();

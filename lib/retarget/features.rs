@@ -165,7 +165,13 @@ pub(crate) fn joint_points(motion: &Motion, skeleton: &Skeleton, repr: Repr, sca
         for k in 1..j {
             let v = match repr {
                 Repr::Velocity => {
-                    let (a, b) = if f > 0 { (f - 1, f) } else if motion.frames > 1 { (0, 1) } else { (0, 0) };
+                    let (a, b) = if f > 0 {
+                        (f - 1, f)
+                    } else if motion.frames > 1 {
+                        (0, 1)
+                    } else {
+                        (0, 0)
+                    };
                     world.position(b, k) - world.position(a, k)
                 }
                 _ => world.position(f, k) - world.position(f, 0),

@@ -132,7 +132,14 @@ pub struct Timings {
 /// from `examples` (motions on `target_skeleton`), with the bound joints of `map` as
 /// (source joint, target joint) index pairs. The source and examples should share a frame
 /// rate (see `resample`); the result has the examples' frame time.
-pub fn retarget(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion], target_skeleton: &Skeleton, map: &JointMap, settings: &Settings) -> Result<Retargeted, RetargetError> {
+pub fn retarget(
+    source: &Motion,
+    source_skeleton: &Skeleton,
+    examples: &[Motion],
+    target_skeleton: &Skeleton,
+    map: &JointMap,
+    settings: &Settings,
+) -> Result<Retargeted, RetargetError> {
     let start = Instant::now();
     let plan = Plan::new(source, source_skeleton, examples, target_skeleton, map, settings)?;
     let prepare = start.elapsed();
@@ -141,7 +148,15 @@ pub fn retarget(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion]
 
 /// `retarget` once per seed (the `-n` diverse samples), in parallel. Each result is the one
 /// `retarget` gives with that seed.
-pub fn retarget_samples(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion], target_skeleton: &Skeleton, map: &JointMap, settings: &Settings, seeds: &[u64]) -> Result<Vec<Retargeted>, RetargetError> {
+pub fn retarget_samples(
+    source: &Motion,
+    source_skeleton: &Skeleton,
+    examples: &[Motion],
+    target_skeleton: &Skeleton,
+    map: &JointMap,
+    settings: &Settings,
+    seeds: &[u64],
+) -> Result<Vec<Retargeted>, RetargetError> {
     let start = Instant::now();
     let plan = Plan::new(source, source_skeleton, examples, target_skeleton, map, settings)?;
     let prepare = start.elapsed();
@@ -198,7 +213,14 @@ struct Plan<'a> {
 }
 
 impl<'a> Plan<'a> {
-    fn new(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion], target: &'a Skeleton, map: &JointMap, settings: &'a Settings) -> Result<Plan<'a>, RetargetError> {
+    fn new(
+        source: &Motion,
+        source_skeleton: &Skeleton,
+        examples: &[Motion],
+        target: &'a Skeleton,
+        map: &JointMap,
+        settings: &'a Settings,
+    ) -> Result<Plan<'a>, RetargetError> {
         settings.validate()?;
         check_inputs(source, source_skeleton, examples, target, map)?;
         let jt = target.len();
@@ -220,7 +242,10 @@ impl<'a> Plan<'a> {
         };
         let key: Vec<usize> = key.into_iter().filter(|&f| f < frames).collect();
         if frames > source.frames {
-            notes.push(format!("output frames {}..{} are past the source's end ({} frames): synthesised from the examples alone", source.frames, frames, source.frames));
+            notes.push(format!(
+                "output frames {}..{} are past the source's end ({} frames): synthesised from the examples alone",
+                source.frames, frames, source.frames
+            ));
         }
         if key.is_empty() {
             notes.push("no source frame falls inside the output: the result is unconditioned".to_string());
@@ -423,7 +448,11 @@ impl<'a> Plan<'a> {
                 state_p = state_p.resize(len);
             }
             self.project(&mut state_m, &mut state_p, len, &resize_weights(&self.known, len));
-            let (cm, cp) = if len == self.frames { (self.clips.iter().map(|c| c.0.clone()).collect(), self.clips.iter().map(|c| c.1.clone()).collect()) } else { level_clips(len) };
+            let (cm, cp) = if len == self.frames {
+                (self.clips.iter().map(|c| c.0.clone()).collect(), self.clips.iter().map(|c| c.1.clone()).collect())
+            } else {
+                level_clips(len)
+            };
             let bank = nn::Bank::new(cm, cp, &self.weights, self.patch);
             let mut level = LevelReport { frames: len, example_frames: bank.frames(), example_patches: bank.len(), ..LevelReport::default() };
             if bank.len() > 0 && len >= self.patch {
@@ -529,7 +558,10 @@ fn check_inputs(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion]
     // before children and one root.
     source_skeleton.validate().map_err(|error| RetargetError::Skeleton { side: "source", error })?;
     target.validate().map_err(|error| RetargetError::Skeleton { side: "target", error })?;
-    if source.joints != source_skeleton.len() || source.rotations.len() != source.frames * source.joints || source.translations.len() != source.frames * source.joints {
+    if source.joints != source_skeleton.len()
+        || source.rotations.len() != source.frames * source.joints
+        || source.translations.len() != source.frames * source.joints
+    {
         return Err(RetargetError::SourceSkeleton { joints: source.joints, skeleton: source_skeleton.len() });
     }
     if source.frames == 0 {
@@ -546,7 +578,9 @@ fn check_inputs(source: &Motion, source_skeleton: &Skeleton, examples: &[Motion]
             return Err(RetargetError::ZeroFrames { what: format!("example clip {i}") });
         }
     }
-    for (what, m) in std::iter::once(("the source motion".to_string(), source)).chain(examples.iter().enumerate().map(|(i, e)| (format!("example clip {i}"), e))) {
+    for (what, m) in
+        std::iter::once(("the source motion".to_string(), source)).chain(examples.iter().enumerate().map(|(i, e)| (format!("example clip {i}"), e)))
+    {
         let bad = m.rotations.iter().zip(&m.translations).position(|(q, p)| !(q.is_finite() && p.is_finite()));
         if let Some(k) = bad {
             return Err(RetargetError::NonFinite { what, frame: k / m.joints, joint: k % m.joints });

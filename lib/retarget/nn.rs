@@ -75,7 +75,17 @@ impl Bank {
     pub fn new(matched: Vec<Channels>, payload: Vec<Channels>, weights: &[f32], patch: usize) -> Bank {
         let width = matched.first().map(|c| c.width).unwrap_or(0);
         let stride = padded(width);
-        let mut bank = Bank { weighted: Vec::new(), matched: Vec::new(), payload: Vec::new(), patches: Vec::new(), first_patch: Vec::new(), norms: Vec::new(), stride, width, patch };
+        let mut bank = Bank {
+            weighted: Vec::new(),
+            matched: Vec::new(),
+            payload: Vec::new(),
+            patches: Vec::new(),
+            first_patch: Vec::new(),
+            norms: Vec::new(),
+            stride,
+            width,
+            patch,
+        };
         for (m, p) in matched.into_iter().zip(payload) {
             if m.frames < patch {
                 continue;

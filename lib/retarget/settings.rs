@@ -124,9 +124,7 @@ impl Default for Settings {
 
 impl Settings {
     pub(crate) fn validate(&self) -> Result<(), RetargetError> {
-        let bad = |what: &str, value: String, expected: &str| {
-            Err(RetargetError::Setting { what: what.to_string(), value, expected: expected.to_string() })
-        };
+        let bad = |what: &str, value: String, expected: &str| Err(RetargetError::Setting { what: what.to_string(), value, expected: expected.to_string() });
         if self.patch == 0 {
             return bad("patch", "0".into(), "at least 1 frame");
         }

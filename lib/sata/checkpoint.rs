@@ -77,7 +77,8 @@ pub struct Frozen {
 /// `rigs`: the contents of `rigs.json`, if the model has one.
 pub fn frozen_bytes(json: &[u8], weights: &[u8], rigs: Option<&[u8]>, device: &Device) -> Result<Frozen, CheckpointError> {
     let info = parse_info(json)?;
-    let tensors = candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
+    let tensors =
+        candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
     let model = SataModel::new(vb, &info.config).map_err(CheckpointError::Mismatch)?;
     let rigs = rigs.map(KnownRigs::parse).transpose()?.unwrap_or_default();

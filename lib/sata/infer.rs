@@ -71,7 +71,10 @@ impl Frozen {
     /// Latent means of raw AnyTop features `[frames, J, 13]` of the skeleton `g`.
     pub fn encode_features(&self, features: &Features, g: &SkeletonGraph, device: &Device) -> Result<Latents, SataError> {
         if features.dims != FEATURE_DIMS || features.joints != g.joints {
-            return Err(SataError::Invalid(format!("features are [{}, {}, {}], the skeleton needs [frames, {}, {FEATURE_DIMS}]", features.frames, features.joints, features.dims, g.joints)));
+            return Err(SataError::Invalid(format!(
+                "features are [{}, {}, {}], the skeleton needs [frames, {}, {FEATURE_DIMS}]",
+                features.frames, features.joints, features.dims, g.joints
+            )));
         }
         if features.frames == 0 {
             return Err(SataError::Invalid("no frames to encode".into()));

@@ -97,7 +97,20 @@ impl SataConfig {
     /// The paper's base model (§4.1.1): width 256, 3 + 3 blocks, 4 heads, ff 512, latent 128,
     /// windows of 64 frames overlapping by 16.
     pub fn paper() -> SataConfig {
-        SataConfig { width: 256, blocks: 3, heads: 4, ff: 512, latent: 128, frequencies: 6, name_dim: 384, window: 64, overlap: 16, ln_eps: 1e-5, relative_latent: true, direct_readout: true }
+        SataConfig {
+            width: 256,
+            blocks: 3,
+            heads: 4,
+            ff: 512,
+            latent: 128,
+            frequencies: 6,
+            name_dim: 384,
+            window: 64,
+            overlap: 16,
+            ln_eps: 1e-5,
+            relative_latent: true,
+            direct_readout: true,
+        }
     }
 
     /// What trains on our CPUs in an hour or two: width 64, 2 + 2 blocks, 32-frame windows

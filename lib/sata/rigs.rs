@@ -9,10 +9,10 @@
 //! ground; with its training rig, from `Chicken_TPOSE.bvh`, it stands and steps). So the model
 //! keeps each trained skeleton's rig, and inference uses it whenever the skeleton matches.
 
+use crate::diffusion::checkpoint::CheckpointError;
 use crate::diffusion::data::{offsets_agree, TrainSet};
 use crate::document::AnyTopSection;
 use crate::skeleton::Skeleton;
-use crate::diffusion::checkpoint::CheckpointError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

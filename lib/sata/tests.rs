@@ -106,7 +106,9 @@ fn feature_scale_divides_by_group_rms_and_undoes_exactly() {
     let mut h = f.clone();
     scale.apply(&mut h, &g.rest);
     // Every joint's position group has unit RMS after scaling.
-    let rms = (h.data.chunks_exact(13).enumerate().filter(|(k, _)| k % h.joints != 0).map(|(_, r)| r[..3].iter().map(|v| v * v).sum::<f32>()).sum::<f32>() / ((h.frames * (h.joints - 1) * 3) as f32)).sqrt();
+    let rms = (h.data.chunks_exact(13).enumerate().filter(|(k, _)| k % h.joints != 0).map(|(_, r)| r[..3].iter().map(|v| v * v).sum::<f32>()).sum::<f32>()
+        / ((h.frames * (h.joints - 1) * 3) as f32))
+        .sqrt();
     assert!((rms - 1.0).abs() < 1e-3, "joint position RMS {rms}");
     // The rest pose itself is all zeros.
     let mut still = Features { frames: 1, data: g.rest.clone(), ..f.clone() };
@@ -138,7 +140,9 @@ fn the_latent_cycle_reaches_decoder_and_encoder_and_can_be_learned() {
     assert!(first.is_finite() && first > 0.0, "cycle loss {first}");
     let grads = c.backward().unwrap();
     let moved = |prefix: &str| {
-        vars.iter().filter(|(n, _)| n.starts_with(prefix)).any(|(_, v)| grads.get(v.as_tensor()).is_some_and(|g| g.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap() > 0.0))
+        vars.iter()
+            .filter(|(n, _)| n.starts_with(prefix))
+            .any(|(_, v)| grads.get(v.as_tensor()).is_some_and(|g| g.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap() > 0.0))
     };
     assert!(moved("decoder.output") && moved("decoder.modulation") && moved("encoder.input"), "the cycle must train both halves");
     let mut opt = crate::diffusion::train::AdamW::new(3e-3);

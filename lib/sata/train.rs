@@ -186,13 +186,27 @@ pub fn batch_tensor(set: &TrainSet, crops: &[Crop], scale: &FeatureScale, rest: 
 
 /// The loss of reconstructing `x` (scaled, `[B, T, J, 13]`) through the model, with the VAE's
 /// sampled latent (noise from `rng`); `scale` is `FeatureScale::tensor` for the skeleton.
-pub fn loss(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> Result<(Tensor, SataLosses), SataError> {
+pub fn loss(
+    model: &SataModel,
+    x: &Tensor,
+    g: &SkeletonGraph,
+    scale: &Tensor,
+    weights: &LossWeights,
+    rng: &mut SplitMix64,
+) -> Result<(Tensor, SataLosses), SataError> {
     let (total, report, _) = loss_with_latent(model, x, g, scale, weights, rng)?;
     Ok((total, report))
 }
 
 /// [`loss`], also giving the latent mean `[B, T, latent]` (for [`cycle_loss`]).
-fn loss_with_latent(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Tensor, weights: &LossWeights, rng: &mut SplitMix64) -> Result<(Tensor, SataLosses, Tensor), SataError> {
+fn loss_with_latent(
+    model: &SataModel,
+    x: &Tensor,
+    g: &SkeletonGraph,
+    scale: &Tensor,
+    weights: &LossWeights,
+    rng: &mut SplitMix64,
+) -> Result<(Tensor, SataLosses, Tensor), SataError> {
     let (mu, logvar) = model.encode(x, g)?;
     let eps = Tensor::from_vec(gaussian(rng, mu.elem_count()), mu.shape(), mu.device())?;
     let z = (&mu + (logvar.clone() * 0.5)?.exp()?.mul(&eps)?)?;
@@ -216,7 +230,8 @@ fn loss_with_latent(model: &SataModel, x: &Tensor, g: &SkeletonGraph, scale: &Te
     // Heights of the non-root joints (dim 1 is absolute height) below the floor.
     let penetration = if j > 1 { raw(&y)?.narrow(2, 1, j - 1)?.narrow(3, 1, 1)?.neg()?.relu()?.mean_all()? } else { rec.zeros_like()? };
     let kl = ((mu.sqr()? + logvar.exp()?)? - 1.0)?.sub(&logvar)?.mean_all()?.affine(0.5, 0.0)?;
-    let total = ((((((&rec + (&root * weights.root)?)? + (&geo * weights.geodesic)?)? + (&smooth * weights.smooth)?)? + (&contact * weights.contact)?)? + (&penetration * weights.penetration)?)?
+    let total = ((((((&rec + (&root * weights.root)?)? + (&geo * weights.geodesic)?)? + (&smooth * weights.smooth)?)? + (&contact * weights.contact)?)?
+        + (&penetration * weights.penetration)?)?
         + (&kl * weights.kl)?)?;
     let v = |t: &Tensor| -> candle_core::Result<f64> { Ok(t.to_scalar::<f32>()? as f64) };
     let report = SataLosses {

@@ -125,7 +125,8 @@ impl SataTrainer {
 impl Trainer for SataTrainer {
     fn step(&mut self, k: u64) -> Result<StepLosses, TrainError> {
         let mut rng = step_rng(self.info.seed, k);
-        let l = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.info.scale, &self.info.weights, &mut rng, self.info.batch, &self.device).map_err(|e| TrainError::Model(e.into()))?;
+        let l = train_step(&self.model, &self.vars, &mut self.opt, &self.set, &self.info.scale, &self.info.weights, &mut rng, self.info.batch, &self.device)
+            .map_err(|e| TrainError::Model(e.into()))?;
         let parts = vec![
             ("reconstruction", l.reconstruction),
             ("root", l.root),

@@ -120,11 +120,12 @@ mod tests {
 
     fn line(n: usize) -> Vec<Vec<f64>> {
         // Points along (1, 2, 0) with a little spread along (0, 0, 1).
-        (0..n).map(|i| {
-            let t = i as f64 - (n as f64 - 1.0) / 2.0;
-            vec![t, 2.0 * t, 0.1 * if i % 2 == 0 { 1.0 } else { -1.0 }]
-        })
-        .collect()
+        (0..n)
+            .map(|i| {
+                let t = i as f64 - (n as f64 - 1.0) / 2.0;
+                vec![t, 2.0 * t, 0.1 * if i % 2 == 0 { 1.0 } else { -1.0 }]
+            })
+            .collect()
     }
 
     #[test]

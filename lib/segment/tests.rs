@@ -57,7 +57,17 @@ fn context_window_tells_a_varying_phase_from_a_still_one() {
 #[test]
 fn refine_moves_a_boundary_to_the_change_of_activity() {
     // Still for 50 frames, then alternating: the change is at 50; a boundary at 44 moves there.
-    let points: Vec<Vec<f64>> = (0..100).map(|t| vec![if t < 50 { 0.0 } else if t % 2 == 0 { 1.0 } else { -1.0 }]).collect();
+    let points: Vec<Vec<f64>> = (0..100)
+        .map(|t| {
+            vec![if t < 50 {
+                0.0
+            } else if t % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            }]
+        })
+        .collect();
     let labels = [vec![0; 44], vec![1; 56]].concat();
     assert_eq!(boundaries(&refine(&points, &labels, 8)), vec![50]);
     // Out of sight (radius 3 looks at frames 38..50, all still): every split scores the same and

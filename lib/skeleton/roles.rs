@@ -67,11 +67,7 @@ pub fn feet(skeleton: &Skeleton) -> (Vec<usize>, FootRule) {
 pub fn sides(skeleton: &Skeleton, normalised: &[String]) -> Vec<Side> {
     let n = skeleton.len();
     let named: Vec<Option<Side>> = normalised.iter().map(|s| names::side_from_name(s)).collect();
-    let geometric = if named.iter().any(Option::is_some) {
-        vec![Side::Centre; n]
-    } else {
-        geometric_sides(skeleton, &skeleton.rest_positions())
-    };
+    let geometric = if named.iter().any(Option::is_some) { vec![Side::Centre; n] } else { geometric_sides(skeleton, &skeleton.rest_positions()) };
     let mut out = vec![Side::Centre; n];
     for j in 0..n {
         out[j] = match named[j] {

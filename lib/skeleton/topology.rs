@@ -30,7 +30,11 @@ pub fn relations(skeleton: &Skeleton) -> Vec<Vec<u8>> {
     for i in 0..n {
         for j in 0..n {
             r[i][j] = if i == j {
-                if children[i].is_empty() { RELATION_END_EFFECTOR } else { RELATION_SELF }
+                if children[i].is_empty() {
+                    RELATION_END_EFFECTOR
+                } else {
+                    RELATION_SELF
+                }
             } else if parents[j] == Some(i) {
                 RELATION_CHILD
             } else if parents[i] == Some(j) {

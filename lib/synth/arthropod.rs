@@ -50,13 +50,7 @@ fn jointed_leg(b: &mut Builder, parent: usize, names: [String; 4], left: bool, a
     let foot = b.add(&names[3], tibia, along(d.tibia.0, d.tibia.1));
     b.end(foot, along(d.end.0, d.end.1));
     let reach = d.attach + d.coxa + d.femur.0 + d.tibia.0 + d.end.0;
-    JointedLeg {
-        coxa,
-        ik: Leg { upper: femur, lower: tibia, tip: Some(foot), rest_pole: DVec3::Y },
-        dir,
-        end: along(d.end.0, d.end.1),
-        home: dir * reach,
-    }
+    JointedLeg { coxa, ik: Leg { upper: femur, lower: tibia, tip: Some(foot), rest_pole: DVec3::Y }, dir, end: along(d.end.0, d.end.1), home: dir * reach }
 }
 
 /// Pose a jointed leg so its foot end touches `contact` (world) with the foot held at the
@@ -85,13 +79,7 @@ pub(super) struct SpiderBody {
 pub(super) fn spider_body(shape: &Proportions) -> SpiderBody {
     let layout = Layout { root_order: "ZYX", joint_order: "ZYX", all_positions: true };
     let (k, l) = (shape.size, shape.size * shape.limbs);
-    let dims = LegDims {
-        attach: 0.04 * k,
-        coxa: 0.025 * l,
-        femur: (0.08 * l, 0.08 * l),
-        tibia: (0.08 * l, -0.12 * l),
-        end: (0.015 * l, -0.04 * l),
-    };
+    let dims = LegDims { attach: 0.04 * k, coxa: 0.025 * l, femur: (0.08 * l, 0.08 * l), tibia: (0.08 * l, -0.12 * l), end: (0.015 * l, -0.04 * l) };
     let body_y = dims.body_height();
     let mut b = Builder::new("cephalothorax", v3(0.0, body_y, 0.0), layout);
     let abdomen = b.add("abdomen", 0, v3(0.0, 0.015 * k, -0.045 * k));
@@ -158,13 +146,7 @@ pub(super) struct CrabBody {
 pub(super) fn crab_body(shape: &Proportions) -> CrabBody {
     let layout = Layout { root_order: "YXZ", joint_order: "XZY", all_positions: false };
     let (k, l) = (shape.size, shape.size * shape.limbs);
-    let dims = LegDims {
-        attach: 0.07 * k,
-        coxa: 0.02 * l,
-        femur: (0.08 * l, 0.05 * l),
-        tibia: (0.07 * l, -0.09 * l),
-        end: (0.03 * l, -0.05 * l),
-    };
+    let dims = LegDims { attach: 0.07 * k, coxa: 0.02 * l, femur: (0.08 * l, 0.05 * l), tibia: (0.07 * l, -0.09 * l), end: (0.03 * l, -0.05 * l) };
     let body_y = dims.body_height();
     let mut b = Builder::new("Carapace", v3(0.0, body_y, 0.0), layout);
     let mut eyes = Vec::new();
@@ -206,10 +188,7 @@ pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
 
     let (frames, period) = frames_for(rng.vary(0.55, 0.06), 4);
     let gait = Gait { period, duty: rng.vary(0.55, 0.03), stride: rng.vary(0.1, 0.08), lift: rng.vary(0.04, 0.1) };
-    let touchdown: Vec<f64> = legs
-        .iter()
-        .map(|&(_, left, i)| (if (i % 2 == 0) == left { 0.0 } else { 0.5 }) + rng.range(-0.03, 0.03))
-        .collect();
+    let touchdown: Vec<f64> = legs.iter().map(|&(_, left, i)| (if (i % 2 == 0) == left { 0.0 } else { 0.5 }) + rng.range(-0.03, 0.03)).collect();
     // Facing -x, the crab's left (+x in the rest pose) leads along +z.
     let heading = ry(-90.0);
     let wave_claw = rng.vary(12.0, 0.2);
@@ -222,11 +201,7 @@ pub(super) fn crab(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         }
         for (k, &(merus, carpus, finger)) in claws.iter().enumerate() {
             // Claws held up and forward, waving out of step with each other and pinching.
-            let q = [
-                ry(-20.0) * rz(10.0 + wave_claw * wave(c + 0.5 * k as f64)),
-                ry(35.0) * rx(-15.0),
-                rx(-12.0 * (0.5 + 0.5 * wave(2.0 * c))),
-            ];
+            let q = [ry(-20.0) * rz(10.0 + wave_claw * wave(c + 0.5 * k as f64)), ry(35.0) * rx(-15.0), rx(-12.0 * (0.5 + 0.5 * wave(2.0 * c)))];
             let q = if k == 0 { q } else { q.map(mirror) };
             p.local(merus, q[0]);
             p.local(carpus, q[1]);
@@ -266,8 +241,7 @@ pub(super) fn centipede_body(shape: &Proportions) -> CentipedeBody {
     let seg_len = 0.05 * k;
     // Each leg: hip (`Leg`), knee (`Shin`) raised above the body, and a short foot standing
     // on the ground so the foot joint itself stays put in stance.
-    let (attach, upper, lower, claw) =
-        (0.012 * k, v3(0.05 * l, 0.025 * l, 0.0), v3(0.04 * l, -0.054 * l, 0.0), v3(0.0, -0.006 * l, 0.0));
+    let (attach, upper, lower, claw) = (0.012 * k, v3(0.05 * l, 0.025 * l, 0.0), v3(0.04 * l, -0.054 * l, 0.0), v3(0.0, -0.006 * l, 0.0));
     let body_y = -(upper.y + lower.y + claw.y);
     let mut b = Builder::new("Segment01", v3(0.0, body_y, 0.0), layout);
     let head = b.add("Head", 0, v3(0.0, 0.004 * k, 0.035 * k));
@@ -316,10 +290,7 @@ pub(super) fn centipede(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     // Retrograde wave: each pair lands `lag` of a cycle after the pair in front of it.
     let wavelength = rng.vary(7.0, 0.1);
     let lag = 1.0 / wavelength;
-    let touchdown: Vec<f64> = legs
-        .iter()
-        .map(|&(_, _, k, left)| k as f64 * lag + if left { 0.0 } else { 0.5 } + rng.range(-0.015, 0.015))
-        .collect();
+    let touchdown: Vec<f64> = legs.iter().map(|&(_, _, k, left)| k as f64 * lag + if left { 0.0 } else { 0.5 } + rng.range(-0.015, 0.015)).collect();
     // The body's lateral wave is prescribed in the world (each segment aims at where the next
     // one should be), not as summed local angles, so its amplitude stays small at the tail
     // too and the legs keep their reach.

@@ -69,8 +69,7 @@ pub(super) fn bird_body(shape: &Proportions) -> BirdBody {
 
 pub(super) fn bird(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     let body = bird_body(&training::proportions("bird", 0).expect("bird exists"));
-    let BirdBody { skel, spine, chest, neck1, neck2, head, wings, legs, tail: [tail1, tail2], hip_drop, shin, tarsus, ankle_y } =
-        body;
+    let BirdBody { skel, spine, chest, neck1, neck2, head, wings, legs, tail: [tail1, tail2], hip_drop, shin, tarsus, ankle_y } = body;
 
     let (frames, period) = frames_for(rng.vary(0.5, 0.06), 5);
     let gait = Gait { period, duty: rng.vary(0.6, 0.03), stride: rng.vary(0.13, 0.08), lift: rng.vary(0.03, 0.1) };

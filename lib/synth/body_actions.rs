@@ -17,8 +17,7 @@ use super::*;
 pub(super) fn bird(job: &Job, rng: &mut SplitMix64) -> Clip {
     let shape = job.shape;
     let body = bird_body(&shape);
-    let BirdBody { skel, spine, chest, neck1, neck2, head, wings, legs, tail: [tail1, tail2], hip_drop, shin, tarsus, ankle_y } =
-        body;
+    let BirdBody { skel, spine, chest, neck1, neck2, head, wings, legs, tail: [tail1, tail2], hip_drop, shin, tarsus, ankle_y } = body;
     let r = shape.size * shape.limbs;
     let hop = job.action == Action::Hop;
     let gait = if hop {
@@ -29,11 +28,7 @@ pub(super) fn bird(job: &Job, rng: &mut SplitMix64) -> Clip {
     let gait = Gait { period: gait.period * r.sqrt(), stride: gait.stride * r, lift: gait.lift * r, ..gait };
     let plan = Plan::new(job, gait, 0.0, 0.0, rng);
     let touchdown = if hop { [0.0, rng.range(0.0, 0.02)] } else { [0.0, 0.5 + rng.range(-0.02, 0.02)] };
-    let feet: Vec<_> = legs
-        .iter()
-        .zip(touchdown)
-        .map(|(&(_, x), td)| plan.foot(job, FootSpec { home: v3(x, 0.0, 0.0), lag: 0.0, touchdown: td }))
-        .collect();
+    let feet: Vec<_> = legs.iter().zip(touchdown).map(|(&(_, x), td)| plan.foot(job, FootSpec { home: v3(x, 0.0, 0.0), lag: 0.0, touchdown: td })).collect();
     let leg_len = shin.length() + tarsus.length();
     let bob = 0.004 * r;
     let strike_y = ankle_y + stand_height(leg_len, gait.half_reach(), 0.93) + hip_drop;
@@ -204,9 +199,27 @@ pub(super) fn fish(job: &Job, rng: &mut SplitMix64) -> Clip {
     let FishBody { skel, head, jaw, fins, pelvic, dorsal, spine, length } = fish_body(&shape, depth);
     let fast = job.action == Action::UndulateFast;
     let idle = job.action == Action::Idle;
-    let beat = rng.vary(if fast { 0.25 } else if idle { 1.4 } else { 0.4 }, 0.08) * shape.size.sqrt();
+    let beat = rng.vary(
+        if fast {
+            0.25
+        } else if idle {
+            1.4
+        } else {
+            0.4
+        },
+        0.08,
+    ) * shape.size.sqrt();
     let speed = rng.vary(if fast { 2.0 } else { 0.9 }, 0.1) * length;
-    let amplitude = rng.vary(if fast { 18.0 } else if idle { 4.0 } else { 14.0 }, 0.1);
+    let amplitude = rng.vary(
+        if fast {
+            18.0
+        } else if idle {
+            4.0
+        } else {
+            14.0
+        },
+        0.1,
+    );
     let gait = Gait { period: beat, duty: 0.5, stride: speed * beat, lift: 0.0 };
     let plan = Plan::new(job, gait, 0.0, 0.0, rng);
     let lambda = rng.vary(5.5, 0.08) * spine.len() as f64 / 6.0;

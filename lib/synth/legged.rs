@@ -321,11 +321,7 @@ fn quad_body(spec: &QuadSpec) -> QuadBody {
     let mut legs: Vec<(Leg, f64, f64, DVec3)> = Vec::new();
     let mut add_leg = |b: &mut Builder, parent: usize, left: bool, front: bool| {
         let s = if left { 1.0 } else { -1.0 };
-        let parts = if front {
-            [Part::UpperArm, Part::Forearm, Part::Forefoot, Part::Foretoe]
-        } else {
-            [Part::Thigh, Part::Calf, Part::Foot, Part::Toe]
-        };
+        let parts = if front { [Part::UpperArm, Part::Forearm, Part::Forefoot, Part::Foretoe] } else { [Part::Thigh, Part::Calf, Part::Foot, Part::Toe] };
         // Front shoulders sit lower on the chest than the hips on the pelvis; equal limbs
         // then reach the same ground.
         let drop = if front { hip_drop + 0.02 * k } else { hip_drop };
@@ -399,11 +395,7 @@ fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
         for (side, w) in wings.iter().enumerate() {
             // Downstroke fast and wide, tips trailing the shoulder.
             let flap = spec.wing_flap;
-            let q = [
-                rz(15.0 + flap * wave(c)),
-                rz(-0.35 * flap * wave(c - 0.1)) * ry(10.0 * (1.0 - cwave(c)) / 2.0),
-                rz(-0.3 * flap * wave(c - 0.2)),
-            ];
+            let q = [rz(15.0 + flap * wave(c)), rz(-0.35 * flap * wave(c - 0.1)) * ry(10.0 * (1.0 - cwave(c)) / 2.0), rz(-0.3 * flap * wave(c - 0.2))];
             for (i, &j) in w.iter().enumerate() {
                 p.local(j, if side == 0 { q[i] } else { mirror(q[i]) });
             }

@@ -169,16 +169,10 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
     let plan = Plan::new(job, gait, 0.0, 0.0, rng);
     let jitter = |rng: &mut SplitMix64| rng.range(-0.02, 0.02);
     // In `legs` order: LF, RF, LH, RH.
-    let touchdown = if trot {
-        [0.5 + jitter(rng), jitter(rng), 0.0, 0.5 + jitter(rng)]
-    } else {
-        [0.25 + jitter(rng), 0.75 + jitter(rng), 0.0, 0.5 + jitter(rng)]
-    };
-    let feet: Vec<_> = legs
-        .iter()
-        .zip(touchdown)
-        .map(|(&(_, x, z, _), td)| plan.foot(job, FootSpec { home: v3(x, 0.0, z), lag: 0.0, touchdown: td }))
-        .collect();
+    let touchdown =
+        if trot { [0.5 + jitter(rng), jitter(rng), 0.0, 0.5 + jitter(rng)] } else { [0.25 + jitter(rng), 0.75 + jitter(rng), 0.0, 0.5 + jitter(rng)] };
+    let feet: Vec<_> =
+        legs.iter().zip(touchdown).map(|(&(_, x, z, _), td)| plan.foot(job, FootSpec { home: v3(x, 0.0, z), lag: 0.0, touchdown: td })).collect();
     let bob = if trot { 0.02 } else { 0.008 } * r;
     let hip_y = ankle_y + stand_height(2.0 * bone, gait.half_reach(), 0.95);
     let walk_y = hip_y + hip_drop - bob;
@@ -197,8 +191,7 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
         let rest = 1.0 - a;
         let c = plan.cycles(t);
         let lh = touchdown[2];
-        let y = a * (walk_y + bob * cwave(2.0 * (c - lh - gait.duty / 2.0)))
-            + rest * (stand_y + 0.003 * r * idle.breath(t));
+        let y = a * (walk_y + bob * cwave(2.0 * (c - lh - gait.duty / 2.0))) + rest * (stand_y + 0.003 * r * idle.breath(t));
         // A pause inside a walk is too short for shifting the weight about.
         let shift = rest * idle.shift(t) * if job.action == Action::Idle { 1.0 } else { 0.15 };
         let roll = roll_amp * a * wave(c - lh) + 1.5 * shift;

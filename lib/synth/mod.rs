@@ -172,29 +172,14 @@ fn round_offset(v: DVec3) -> DVec3 {
 
 impl Builder {
     pub fn new(root: &str, at: DVec3, layout: Layout) -> Builder {
-        let joint = Joint {
-            name: root.to_string(),
-            parent: None,
-            offset: round_offset(at),
-            channels: with_positions(layout.root_order),
-            end_sites: Vec::new(),
-        };
+        let joint =
+            Joint { name: root.to_string(), parent: None, offset: round_offset(at), channels: with_positions(layout.root_order), end_sites: Vec::new() };
         Builder { joints: vec![joint], layout }
     }
 
     pub fn add(&mut self, name: &str, parent: usize, offset: DVec3) -> usize {
-        let channels = if self.layout.all_positions {
-            with_positions(self.layout.joint_order)
-        } else {
-            rotation_channels(self.layout.joint_order)
-        };
-        self.joints.push(Joint {
-            name: name.to_string(),
-            parent: Some(parent),
-            offset: round_offset(offset),
-            channels,
-            end_sites: Vec::new(),
-        });
+        let channels = if self.layout.all_positions { with_positions(self.layout.joint_order) } else { rotation_channels(self.layout.joint_order) };
+        self.joints.push(Joint { name: name.to_string(), parent: Some(parent), offset: round_offset(offset), channels, end_sites: Vec::new() });
         self.joints.len() - 1
     }
 

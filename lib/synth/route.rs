@@ -48,14 +48,7 @@ impl Route {
     /// Integrate `speed(t)` (m/s) and `curvature(t)` (radians of heading per metre travelled)
     /// over `[start, end]`, anchored so that at t = 0 the frame is at the origin with heading
     /// `yaw0`. Heading changes only while moving, so a stopped body never spins.
-    pub fn new(
-        start: f64,
-        end: f64,
-        yaw0: f64,
-        travel: f64,
-        speed: impl Fn(f64) -> f64,
-        curvature: impl Fn(f64) -> f64,
-    ) -> Route {
+    pub fn new(start: f64, end: f64, yaw0: f64, travel: f64, speed: impl Fn(f64) -> f64, curvature: impl Fn(f64) -> f64) -> Route {
         let dt = FRAME_TIME / 8.0;
         let n = ((end - start) / dt).ceil().max(1.0) as usize + 1;
         let mut s = Vec::with_capacity(n);

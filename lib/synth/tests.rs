@@ -171,9 +171,8 @@ pub(super) fn planting(skel: &Skeleton, motion: &Motion) -> Vec<(String, f64, f6
             let at = |f: usize| world.position(f, j) + world.rotations[f * world.joints + j] * end;
             let heights: Vec<f64> = (0..n).map(|f| at(f).y).collect();
             let ground = heights.iter().copied().fold(f64::INFINITY, f64::min);
-            let speeds: Vec<(bool, f64)> = (1..n - 1)
-                .map(|f| (heights[f] - ground < near, flat(at(f + 1) - at(f - 1)).length() / (2.0 * dt) / root_speed))
-                .collect();
+            let speeds: Vec<(bool, f64)> =
+                (1..n - 1).map(|f| (heights[f] - ground < near, flat(at(f + 1) - at(f - 1)).length() / (2.0 * dt) / root_speed)).collect();
             let stance: Vec<f64> = speeds.iter().filter(|s| s.0).map(|s| s.1).collect();
             let median = Stats::of(&stance).map_or(f64::INFINITY, |s| s.median);
             let fastest = speeds.iter().map(|s| s.1).fold(0.0, f64::max);

@@ -102,8 +102,7 @@ fn variant_zero_is_the_example_creature_and_others_differ() {
 #[test]
 fn variants_change_joint_counts_where_bodies_repeat() {
     for name in ["quadruped", "dragon", "centipede", "snake", "fish"] {
-        let counts: std::collections::BTreeSet<usize> =
-            (0..10).map(|v| clip(name, v, main_action(name)).skeleton.len()).collect();
+        let counts: std::collections::BTreeSet<usize> = (0..10).map(|v| clip(name, v, main_action(name)).skeleton.len()).collect();
         assert!(counts.len() >= 3, "{name}: joint counts {counts:?}");
     }
     for name in ["biped", "spider", "crab", "bird"] {

@@ -169,8 +169,7 @@ pub(super) fn fish_body(shape: &Proportions, depth: f64) -> FishBody {
 /// A fish swimming in mid-water, snake_case names with `_L`/`_R` fins.
 pub(super) fn fish(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     let depth = 0.5;
-    let FishBody { skel, head, jaw, fins, pelvic, dorsal, spine, .. } =
-        fish_body(&training::proportions("fish", 0).expect("fish exists"), depth);
+    let FishBody { skel, head, jaw, fins, pelvic, dorsal, spine, .. } = fish_body(&training::proportions("fish", 0).expect("fish exists"), depth);
 
     let beat = rng.vary(0.4, 0.08);
     let (frames, period) = frames_for(beat, 8);

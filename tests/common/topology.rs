@@ -21,11 +21,7 @@ pub fn reference_distances(parents: &[Option<usize>], dmax: usize) -> Vec<Vec<u8
         for j in 0..n {
             // Lowest common ancestor: the first of i's ancestors (i itself first) that is also
             // one of j's; the hops are the steps up from i plus the steps up from j.
-            let hops = anc[i]
-                .iter()
-                .enumerate()
-                .find_map(|(up_i, a)| anc[j].iter().position(|b| b == a).map(|up_j| up_i + up_j))
-                .unwrap_or(usize::MAX); // different roots: unreachable
+            let hops = anc[i].iter().enumerate().find_map(|(up_i, a)| anc[j].iter().position(|b| b == a).map(|up_j| up_i + up_j)).unwrap_or(usize::MAX); // different roots: unreachable
             d[i][j] = hops.min(dmax) as u8;
         }
     }

@@ -1,10 +1,7 @@
 //! AnyTop features -> positions -> Motion on the original skeleton (§1.10).
 
 use super::rig::Prepared;
-use super::{
-    get3, get_6d, yaw_to_front, AnyTopError, AnyTopRig, IkOptions, Placement, DIMS_POSITION, DIMS_ROTATION,
-    DIMS_VELOCITY, FEATURE_DIMS,
-};
+use super::{get3, get_6d, yaw_to_front, AnyTopError, AnyTopRig, IkOptions, Placement, DIMS_POSITION, DIMS_ROTATION, DIMS_VELOCITY, FEATURE_DIMS};
 use crate::motion::rotation::from_6d;
 use crate::motion::Motion;
 use crate::repr::Features;
@@ -31,12 +28,7 @@ const RIC_PRECISION: f64 = 1.5e-7;
 impl AnyTopRig {
     /// World positions (BVH units and axes, `[frame * joints + joint]`) that the features'
     /// positions describe (§1.10 steps 2–3), put in place by `placement`.
-    pub fn recover_positions(
-        &self,
-        skeleton: &Skeleton,
-        features: &Features,
-        placement: &Placement,
-    ) -> Result<Vec<DVec3>, AnyTopError> {
+    pub fn recover_positions(&self, skeleton: &Skeleton, features: &Features, placement: &Placement) -> Result<Vec<DVec3>, AnyTopError> {
         let prep = self.prepare(skeleton)?;
         let rec = recover(&prep, features, placement)?;
         let q_inv = rec.q.inverse();
@@ -46,30 +38,18 @@ impl AnyTopRig {
     /// Decode from the rotations: exact for encoded data. Joints with position channels take
     /// their translation from the positions; leaves (whose rotation is not represented) get
     /// their rest rotation. Frame time: the skeleton's.
-    pub fn decode(
-        &self,
-        skeleton: &Skeleton,
-        features: &Features,
-        placement: &Placement,
-    ) -> Result<Motion, AnyTopError> {
+    pub fn decode(&self, skeleton: &Skeleton, features: &Features, placement: &Placement) -> Result<Motion, AnyTopError> {
         let prep = self.prepare(skeleton)?;
         let rec = recover(&prep, features, placement)?;
         let n = skeleton.len();
-        let local: Vec<DQuat> =
-            (0..features.frames * n).map(|k| slot_rotation(&prep, features, k / n, k % n)).collect();
+        let local: Vec<DQuat> = (0..features.frames * n).map(|k| slot_rotation(&prep, features, k / n, k % n)).collect();
         Ok(rebuild(&prep, skeleton, rec.q, &local, &rec))
     }
 
     /// Decode from the positions: rotations fitted to the features' positions with the natural
     /// rest pose by inverse kinematics (`ik.rs`), for generated features whose positions and
     /// rotations disagree. Joints with position channels land exactly on their positions.
-    pub fn decode_ik(
-        &self,
-        skeleton: &Skeleton,
-        features: &Features,
-        placement: &Placement,
-        options: &IkOptions,
-    ) -> Result<Motion, AnyTopError> {
+    pub fn decode_ik(&self, skeleton: &Skeleton, features: &Features, placement: &Placement, options: &IkOptions) -> Result<Motion, AnyTopError> {
         let prep = self.prepare(skeleton)?;
         let rec = recover(&prep, features, placement)?;
         let n = skeleton.len();
@@ -118,11 +98,7 @@ fn check_features(prep: &Prepared, features: &Features) -> Result<(), AnyTopErro
         return Err(AnyTopError::Dims(features.dims));
     }
     if features.joints != prep.parents.len() {
-        return Err(AnyTopError::JointCount {
-            what: "the features",
-            got: features.joints,
-            expected: prep.parents.len(),
-        });
+        return Err(AnyTopError::JointCount { what: "the features", got: features.joints, expected: prep.parents.len() });
     }
     if let Some((frame, joint, dim)) = features.first_non_finite() {
         return Err(AnyTopError::NonFinite { frame, joint, dim });
@@ -179,8 +155,7 @@ pub(super) fn rebuild(prep: &Prepared, skeleton: &Skeleton, q: DQuat, local: &[D
                 rotations[k] = (q_inv * local[k] * prep.rest_world[0]).normalize();
                 world[k] = (local[k] * prep.rest_world[0]).normalize();
                 positions[k] = rec.targets[k];
-                translations[k] =
-                    if prep.has_position[0] { prep.unalign(q_inv, rec.targets[k]) } else { prep.offsets[0] };
+                translations[k] = if prep.has_position[0] { prep.unalign(q_inv, rec.targets[k]) } else { prep.offsets[0] };
             }
             continue;
         };
@@ -192,8 +167,7 @@ pub(super) fn rebuild(prep: &Prepared, skeleton: &Skeleton, q: DQuat, local: &[D
             positions[k] = positions[at(t, p)] + prep.scale * (world[at(t, p)] * prep.rest_translations[j]);
             translations[k] = prep.rest_translations[j];
         }
-        let exact =
-            |t: usize| positions[at(t, j)].distance(rec.targets[at(t, j)]) <= rec.slack[at(t, j)] + rec.slack[at(t, p)];
+        let exact = |t: usize| positions[at(t, j)].distance(rec.targets[at(t, j)]) <= rec.slack[at(t, j)] + rec.slack[at(t, p)];
         if prep.has_position[j] && !(0..frames).all(exact) {
             for t in 0..frames {
                 let (k, kp) = (at(t, j), at(t, p));

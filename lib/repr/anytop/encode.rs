@@ -2,8 +2,8 @@
 
 use super::rig::Prepared;
 use super::{
-    heading_of, put3, put_6d, yaw_to_front, AnyTopError, AnyTopRig, Encoded, Placement, DIMS_POSITION, DIMS_ROTATION,
-    DIMS_VELOCITY, DIM_CONTACT, FEATURE_DIMS, FOOT_CONTACT_HEIGHT, FOOT_CONTACT_SQUARED_DISPLACEMENT,
+    heading_of, put3, put_6d, yaw_to_front, AnyTopError, AnyTopRig, Encoded, Placement, DIMS_POSITION, DIMS_ROTATION, DIMS_VELOCITY, DIM_CONTACT, FEATURE_DIMS,
+    FOOT_CONTACT_HEIGHT, FOOT_CONTACT_SQUARED_DISPLACEMENT,
 };
 use crate::motion::Motion;
 use crate::repr::Features;
@@ -56,10 +56,7 @@ impl AnyTopRig {
                 }
                 let step = next[j] - now[j];
                 put3(&mut out[DIMS_VELOCITY], r_next * step);
-                if prep.is_foot[j]
-                    && step.length_squared() <= FOOT_CONTACT_SQUARED_DISPLACEMENT
-                    && next[j].y.abs() <= FOOT_CONTACT_HEIGHT
-                {
+                if prep.is_foot[j] && step.length_squared() <= FOOT_CONTACT_SQUARED_DISPLACEMENT && next[j].y.abs() <= FOOT_CONTACT_HEIGHT {
                     out[DIM_CONTACT] = 1.0;
                 }
             }

@@ -45,23 +45,12 @@ pub(super) struct Scratch {
 
 impl Scratch {
     pub fn new(n: usize) -> Scratch {
-        Scratch {
-            world: vec![DQuat::IDENTITY; n],
-            positions: vec![DVec3::ZERO; n],
-            rest_dirs: Vec::new(),
-            target_dirs: Vec::new(),
-        }
+        Scratch { world: vec![DQuat::IDENTITY; n], positions: vec![DVec3::ZERO; n], rest_dirs: Vec::new(), target_dirs: Vec::new() }
     }
 }
 
 /// Re-expressed local rotations (aligned space) of one frame that reach `targets`.
-pub(super) fn solve_frame(
-    prep: &Prepared,
-    targets: &[DVec3],
-    options: &IkOptions,
-    s: &mut Scratch,
-    local: &mut [DQuat],
-) {
+pub(super) fn solve_frame(prep: &Prepared, targets: &[DVec3], options: &IkOptions, s: &mut Scratch, local: &mut [DQuat]) {
     for j in 0..targets.len() {
         let parent_world = prep.parents[j].map_or(DQuat::IDENTITY, |p| s.world[p]);
         s.positions[j] = match prep.parents[j] {

@@ -17,9 +17,7 @@
 //! faces along its body: front and back are the ends of the skeleton's longest path (by bone
 //! length), front being the end nearer the head (else away from the tail, else nearer the root).
 
-use super::{
-    heading_of, yaw_to_front, AnyTopError, AnyTopOptions, Facing, Provenance, RestSource, HUMANML_MEAN_BONE_LENGTH,
-};
+use super::{heading_of, yaw_to_front, AnyTopError, AnyTopOptions, Facing, Provenance, RestSource, HUMANML_MEAN_BONE_LENGTH};
 use crate::motion::Motion;
 use crate::repr::Features;
 use crate::skeleton::names::{self, Side};
@@ -60,24 +58,8 @@ const FACE_PART_WORDS: &[&str] = &[
 const FREE_TRANSLATION_FRACTION: f64 = 0.5;
 
 /// Words (of normalised names, lower case) that mark the head end of a body.
-const HEAD_WORDS: &[&str] = &[
-    "head",
-    "neck",
-    "skull",
-    "jaw",
-    "mouth",
-    "beak",
-    "bill",
-    "nose",
-    "snout",
-    "eye",
-    "eyes",
-    "antenna",
-    "mandible",
-    "chelicera",
-    "cephalothorax",
-    "lip",
-];
+const HEAD_WORDS: &[&str] =
+    &["head", "neck", "skull", "jaw", "mouth", "beak", "bill", "nose", "snout", "eye", "eyes", "antenna", "mandible", "chelicera", "cephalothorax", "lip"];
 
 /// Everything AnyTop derives from a skeleton's rest clip; with the `Skeleton` it is enough to
 /// encode clips and decode features back to BVH. Plain numbers, so it serialises into the
@@ -285,17 +267,14 @@ impl AnyTopRig {
         }
         let rest_offsets: Vec<DVec3> = self.rest_offsets.iter().map(|o| DVec3::from_array(*o)).collect();
         let offsets: Vec<DVec3> = skeleton.joints.iter().map(|j| j.offset).collect();
-        let has_position: Vec<bool> =
-            skeleton.joints.iter().map(|j| j.channels.iter().any(|c| !c.is_rotation())).collect();
+        let has_position: Vec<bool> = skeleton.joints.iter().map(|j| j.channels.iter().any(|c| !c.is_rotation())).collect();
         let mut rest_translations = offsets.clone();
         for j in 1..n {
             let p = parents[j].expect("validated");
             let t = rest_world[p].inverse() * rest_offsets[j] / self.scale_factor;
             if has_position[j] {
                 rest_translations[j] = t;
-            } else if t.distance(offsets[j])
-                > 1e-6 * offsets[j].length() + 1e-7 * HUMANML_MEAN_BONE_LENGTH / self.scale_factor
-            {
+            } else if t.distance(offsets[j]) > 1e-6 * offsets[j].length() + 1e-7 * HUMANML_MEAN_BONE_LENGTH / self.scale_factor {
                 return Err(AnyTopError::BadRig(format!(
                     "joint {j} '{}': the rig's rest bone does not match the skeleton's OFFSET (a rig of another skeleton?)",
                     skeleton.joints[j].name
@@ -347,11 +326,7 @@ impl AnyTopRig {
     /// one-frame rest clip). `rest` must be the clip the rig was built from.
     pub fn rest_features(&self, skeleton: &Skeleton, rest: &Motion) -> Result<Features, AnyTopError> {
         if rest.joints != skeleton.len() {
-            return Err(AnyTopError::JointCount {
-                what: "the rest motion",
-                got: rest.joints,
-                expected: skeleton.len(),
-            });
+            return Err(AnyTopError::JointCount { what: "the rest motion", got: rest.joints, expected: skeleton.len() });
         }
         if rest.frames == 0 {
             return Err(AnyTopError::EmptyRest);
@@ -376,8 +351,7 @@ impl AnyTopRig {
     /// The placement that puts a decoded clip where the rest pose stands, facing its way
     /// (for generated features, which carry no placement).
     pub fn rest_placement(&self) -> super::Placement {
-        let root =
-            yaw_to_front(self.rest_heading).inverse() * DVec3::new(self.root_origin_xz[0], 0.0, self.root_origin_xz[1]);
+        let root = yaw_to_front(self.rest_heading).inverse() * DVec3::new(self.root_origin_xz[0], 0.0, self.root_origin_xz[1]);
         super::Placement { heading: self.rest_heading, root_xz: [root.x, root.z] }
     }
 }
@@ -422,7 +396,6 @@ fn mirror_key(raw: &str) -> String {
         .collect::<Vec<_>>()
         .join("_")
 }
-
 
 /// The automatic facing rule (module doc).
 pub(super) fn automatic_facing(skeleton: &Skeleton, p0: &[DVec3], feet: &[usize]) -> Facing {
@@ -491,15 +464,9 @@ pub(super) fn automatic_facing(skeleton: &Skeleton, p0: &[DVec3], feet: &[usize]
     let axis = head.map(|(_, axis)| axis).unwrap_or(DVec3::Z);
     let frontness = |&(r, l): &(usize, usize)| ((p0[r] + p0[l]) * 0.5 - centroid).dot(axis);
     let by_front = |a: &(usize, usize), b: &(usize, usize)| frontness(a).total_cmp(&frontness(b));
-    let limbs: Vec<(usize, usize)> =
-        pairs.iter().copied().filter(|p| pair_reach(p) >= LIMB_REACH_FRACTION * longest).collect();
+    let limbs: Vec<(usize, usize)> = pairs.iter().copied().filter(|p| pair_reach(p) >= LIMB_REACH_FRACTION * longest).collect();
     let legs: Vec<(usize, usize)> = pairs.iter().copied().filter(|&(r, l)| holds_foot[r] || holds_foot[l]).collect();
-    let hips = legs
-        .iter()
-        .copied()
-        .min_by(by_front)
-        .or_else(|| limbs.iter().copied().min_by(by_front))
-        .expect("the longest pair is a limb");
+    let hips = legs.iter().copied().min_by(by_front).or_else(|| limbs.iter().copied().min_by(by_front)).expect("the longest pair is a limb");
     let shoulders = limbs.iter().copied().filter(|&p| p != hips).max_by(by_front).unwrap_or(hips);
 
     let extent = skeleton.rest_extent().max(1e-12);
@@ -519,8 +486,7 @@ pub(super) fn automatic_facing(skeleton: &Skeleton, p0: &[DVec3], feet: &[usize]
 fn body_front(skeleton: &Skeleton, normalised: &[String], sides: &[Side], p0: &[DVec3]) -> Option<(DVec3, DVec3)> {
     let n = skeleton.len();
     let has_word = |j: usize, words: &[&str]| normalised[j].to_lowercase().split(' ').any(|w| words.contains(&w));
-    let mean_of =
-        |set: Vec<usize>| (!set.is_empty()).then(|| set.iter().map(|&j| p0[j]).sum::<DVec3>() / set.len() as f64);
+    let mean_of = |set: Vec<usize>| (!set.is_empty()).then(|| set.iter().map(|&j| p0[j]).sum::<DVec3>() / set.len() as f64);
     let centroid = p0.iter().copied().sum::<DVec3>() / n as f64;
     let centre_head: Vec<usize> = (0..n).filter(|&j| sides[j] == Side::Centre && has_word(j, HEAD_WORDS)).collect();
     let any_head: Vec<usize> = (0..n).filter(|&j| has_word(j, HEAD_WORDS)).collect();
@@ -540,13 +506,7 @@ fn body_front(skeleton: &Skeleton, normalised: &[String], sides: &[Side], p0: &[
 }
 
 /// Facing along the body for a creature without left/right limbs.
-fn body_axis(
-    skeleton: &Skeleton,
-    parents: &[Option<usize>],
-    children: &[Vec<usize>],
-    p0: &[DVec3],
-    head: Option<(DVec3, DVec3)>,
-) -> Facing {
+fn body_axis(skeleton: &Skeleton, parents: &[Option<usize>], children: &[Vec<usize>], p0: &[DVec3], head: Option<(DVec3, DVec3)>) -> Facing {
     let n = skeleton.len();
     // Farthest joint from `start` along the tree, by bone length.
     let farthest = |start: usize| -> usize {
@@ -557,8 +517,7 @@ fn body_axis(
             let nbrs = children[u].iter().copied().chain(parents[u]);
             for v in nbrs {
                 if dist[v].is_nan() {
-                    let bone =
-                        if parents[v] == Some(u) { skeleton.joints[v].offset } else { skeleton.joints[u].offset };
+                    let bone = if parents[v] == Some(u) { skeleton.joints[v].offset } else { skeleton.joints[u].offset };
                     dist[v] = dist[u] + bone.length();
                     stack.push(v);
                 }

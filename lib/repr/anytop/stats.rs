@@ -115,8 +115,7 @@ fn group_std(std: &mut [f64], joints: usize) {
             std[at(0, d)] = root;
         }
         if joints > 1 {
-            let total: f64 =
-                (1..joints).flat_map(|j| range.clone().map(move |d| (j, d))).map(|(j, d)| std[at(j, d)]).sum();
+            let total: f64 = (1..joints).flat_map(|j| range.clone().map(move |d| (j, d))).map(|(j, d)| std[at(j, d)]).sum();
             let shared = total / ((joints - 1) * range.len()) as f64;
             for j in 1..joints {
                 for d in range.clone() {
