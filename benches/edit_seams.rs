@@ -2,7 +2,7 @@
 //! and generated frames (`diffusion::edit::seam_jump`), for the known motion imposed at every
 //! step (ours) against two baselines — plain sampling with the reference's frames pasted in
 //! afterwards, and the upstream's editing, which imposes zeros (the mean pose) instead of the
-//! reference (reference/anytop.md §5), pasted afterwards too. Next to: the same statistic
+//! reference (docs/reference/anytop.md §5), pasted afterwards too. Next to: the same statistic
 //! inside the generated frames and over the reference clip itself (the training data).
 //!
 //!     MENAGERIE_EDIT_MODEL=/tmp/edit_model cargo bench --bench edit_seams

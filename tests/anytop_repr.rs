@@ -1,6 +1,6 @@
 //! AnyTop representation: exact round trips on every frame of every corpus file and example
-//! creature, the reference's invariants (anytop.md §1.6) on real clips, rig serialisation,
-//! statistics. The worst errors are printed (run with `--nocapture`).
+//! creature, the reference's invariants (docs/reference/anytop.md §1.6) on real clips, rig
+//! serialisation, statistics. The worst errors are printed (run with `--nocapture`).
 mod common;
 
 use menagerie::bvh;
@@ -237,9 +237,9 @@ fn corpus_round_trips_exactly() {
     check_all(&common::corpus_bvh_files(&data), "corpus");
 }
 
-/// anytop.md §1.6, as verified on the reference's processed arrays: root dims 0 and 2 exactly
-/// zero, root 6D a pure yaw, contacts in {0, 1} and only on foot joints; plus frame 0 faces +Z.
-/// Mean velocity of all joints in the facing frame (dims 9..12): where the clip travels.
+/// docs/reference/anytop.md §1.6, as verified on the reference's processed arrays: root dims 0 and
+/// 2 exactly zero, root 6D a pure yaw, contacts in {0, 1} and only on foot joints; plus frame 0
+/// faces +Z. Mean velocity of all joints in the facing frame (dims 9..12): where the clip travels.
 fn mean_velocity(f: &Features) -> [f64; 3] {
     let mut sum = [0.0f64; 3];
     for t in 0..f.frames {

@@ -33,7 +33,7 @@ const MAX_FRAMES: usize = 240;
 const SEEDS: u64 = 3;
 
 // ---------------------------------------------------------------------------------------------
-// Brute-force topology (AnyTop §2.4), independent of lib/skeleton/topology.rs.
+// Brute-force topology (docs/reference/anytop.md §2.4), independent of lib/skeleton/topology.rs.
 
 fn check_topology(name: &str, skeleton: &Skeleton) {
     skeleton.validate().unwrap_or_else(|e| panic!("{name}: {e}"));

@@ -1,6 +1,6 @@
 //! Topology descriptors against brute-force references written independently here:
 //!
-//! * relations R straight from AnyTop's definition (reference/anytop.md §2.4): for row i and
+//! * relations R straight from AnyTop's definition (docs/reference/anytop.md §2.4): for row i and
 //!   column j the first matching rule wins: 0 self, 2 child (parent(j) = i), 1 parent
 //!   (j = parent(i)), 3 sibling (parent(j) = parent(i)), 4 none; then the diagonal entry of every
 //!   joint without children becomes 5;

@@ -6,7 +6,7 @@
 //! member has at most one child), and cutting any of them, or the leaf end of one, leaves one
 //! tree whose surviving joints keep all their ancestors, hence their exact world positions.
 //!
-//! Where this deliberately differs from the upstream code (reference/anytop.md §4):
+//! Where this deliberately differs from the upstream code (docs/reference/anytop.md §4):
 //! * the rate is a fraction of *all* joints, reached by whole chains (plus at most one partial
 //!   chain, cut from its leaf end), as the paper describes; upstream removes
 //!   floor(rate x #end effectors) single leaves, which barely changes a skeleton with few leaves;

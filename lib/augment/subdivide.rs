@@ -4,7 +4,7 @@
 //! the old joint hangs from the new one, the OFFSET is split in half, and the new joint keeps
 //! identity rotation in every frame, so every original joint keeps its world position and
 //! rotation exactly. The upstream code instead inserts a self-parented, disconnected joint
-//! (reference/anytop.md §4 and §9.10); we fix that rather than copy it.
+//! (docs/reference/anytop.md §4 and §9.10); we fix that rather than copy it.
 //!
 //! Bones are chosen uniformly among the non-degenerate bones of the skeleton *as it is at that
 //! moment*, so with several additions a bone may be split again (its halves are bones too).

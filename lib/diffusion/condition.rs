@@ -87,7 +87,8 @@ pub fn fallback_stats(rest_row: &[Vec<f32>], trained: &[&AnyTopStats]) -> Result
     for s in trained {
         for k in 0..d {
             root[k] += s.std[k] / trained.len() as f32;
-            // Joint 1's spreads stand for every non-root joint (they share them, §1.8).
+            // Joint 1's spreads stand for every non-root joint (they share them,
+            // docs/reference/anytop.md §1.8).
             joint[k] += s.std.get(d + k).copied().unwrap_or(s.std[k]) / trained.len() as f32;
         }
     }

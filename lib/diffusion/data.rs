@@ -1,7 +1,8 @@
-//! Training data for the denoiser (AnyTop §1.7–1.9, §3.5): clips grouped by skeleton, each
-//! skeleton with its rig, rest-pose row P_S, normalisation statistics, topology (R, D) and joint
-//! name embeddings; clips encoded and normalised once; batches of random 40-frame crops drawn
-//! by the balancing sampler (every skeleton equally likely, then a clip of it uniformly).
+//! Training data for the denoiser (docs/reference/anytop.md §1.7–1.9, §3.5): clips grouped by
+//! skeleton, each skeleton with its rig, rest-pose row P_S, normalisation statistics, topology
+//! (R, D) and joint name embeddings; clips encoded and normalised once; batches of random
+//! 40-frame crops drawn by the balancing sampler (every skeleton equally likely, then a clip of
+//! it uniformly).
 //!
 //! Grouping: clips whose joint names and parents are identical and whose rest offsets agree
 //! within `OFFSET_TOLERANCE` (relative to the skeleton's size) share a skeleton. Proportions
@@ -11,7 +12,7 @@
 //! a skeleton is the first two frames of a clip whose file name says T-pose, else of its first
 //! clip (AnyTop's rule, `anytop::names_tpose`).
 //!
-//! Skeletal augmentation (AnyTop §3.3, appendix C; reference/anytop.md §4): upstream edits
+//! Skeletal augmentation (AnyTop §3.3, appendix C; docs/reference/anytop.md §4): upstream edits
 //! every drawn sample on the fly, choosing uniformly among {none, remove joints, add a joint}.
 //! Re-encoding clips on every draw would cost more than the training step, so we precompute
 //! `Augmentation::variants` edited skeletons per skeleton at build time through `crate::augment`

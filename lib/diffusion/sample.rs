@@ -54,8 +54,9 @@ pub(super) struct Imposed<'a> {
 
 /// The sampling loop, in normalised units. With a known part, the model's input x_t carries
 /// the reference noised to step t (q_sample) at the known elements, and its x0 prediction is
-/// overridden there by the reference (AnyTop §5; the upstream passes zeros as the reference),
-/// so the generated part is denoised next to the motion it has to join.
+/// overridden there by the reference (AnyTop paper §5; the upstream passes zeros as the reference,
+/// docs/reference/anytop.md §5), so the generated part is denoised next to the motion it has to
+/// join.
 pub(super) fn denoise(
     model: &Denoiser,
     schedule: &Schedule,

@@ -1,6 +1,6 @@
 //! AnyTop's diffusion process as numbers: the cosine noise schedule (T = 100), the forward
 //! (noising) coefficients, and the per-step coefficients of the samplers — ancestral DDPM on
-//! all steps, as the reference samples (`reference/anytop.md` §3.1–3.2), and the fast ones: a
+//! all steps, as the reference samples (`docs/reference/anytop.md` §3.1–3.2), and the fast ones: a
 //! respaced DDPM and DDIM on a subset of steps.
 //!
 //! Everything here is plain f64 scalars so that it can be tested exactly and shared by the

@@ -1,6 +1,7 @@
-//! Training the denoiser (AnyTop §3.3–3.4): x0 prediction, loss = masked MSE in normalised
-//! space over real joints and frames plus λ_geo × the geodesic rotation angle, AdamW (lr 1e-4, no weight decay, as the reference), and
-//! checkpoints that can resume exactly.
+//! Training the denoiser (AnyTop paper §3.3, docs/reference/anytop.md §3.3–3.4): x0 prediction,
+//! loss = masked MSE in normalised space over real joints and frames plus λ_geo × the geodesic
+//! rotation angle, AdamW (lr 1e-4, no weight decay, as the reference), and checkpoints that can
+//! resume exactly.
 //!
 //! The optimiser is ours rather than candle-nn's `AdamW` because a checkpoint must carry the
 //! moment estimates (candle-nn keeps them private), and resuming must continue the same run.

@@ -1,9 +1,9 @@
 //! NPY (numpy's `.npy` format) read and write, on any `Read`/`Write`.
 //!
 //! Motion tensors travel between our tools, and out to Python, as plain `.npy` files (see
-//! DESIGN.md, "pipeline contract"). The format is small enough to own: a magic string, a
-//! version, a Python-literal header dict (`descr`, `fortran_order`, `shape`) padded with spaces
-//! to a 64-byte boundary, then the raw values. Owning it means no dependency, no seeking (so
+//! docs/ARCHITECTURE.md, "Formats between the tools"). The format is small enough to own: a magic
+//! string, a version, a Python-literal header dict (`descr`, `fortran_order`, `shape`) padded with
+//! spaces to a 64-byte boundary, then the raw values. Owning it means no dependency, no seeking (so
 //! pipes work both ways), and errors that say which file and what was found.
 //!
 //! * The writer emits version 1.0 (2.0 only if a header could not fit in 65535 bytes),

@@ -8,7 +8,7 @@
 //! (tiny negatives included) count as zero, and the result is clamped at 0.
 //!
 //! Motion2Motion scores transfers with the FID of kinetic features; the recipe it inherits
-//! (Bailando's `calc_metrics`, see reference/motion2motion.md §3.7) first normalises both sets
+//! (Bailando's `calc_metrics`, see docs/reference/motion2motion.md §3.7) first normalises both sets
 //! by the **real** set's per-dimension mean and population std. [`FidOptions::normalise`]
 //! does that (default on). Definitions and deviations: `docs/metrics.md`.
 

@@ -1,8 +1,8 @@
 //! AnyTop's generation metrics: coverage, local / global / inter / intra diversity and the
-//! intra-diversity difference (paper §5, reference `eval/eval_truebones.py`, reference/anytop.md
-//! §6). They descend from GANimator's and SinMDM's single-motion metrics: windows of a motion
-//! are matched to their nearest windows in another set, and a dynamic programme tiles a
-//! generated motion with pieces of a ground-truth (GT) clip.
+//! intra-diversity difference (paper §6.3, reference `eval/eval_truebones.py`,
+//! docs/reference/anytop.md §6). They descend from GANimator's and SinMDM's single-motion metrics:
+//! windows of a motion are matched to their nearest windows in another set, and a dynamic programme
+//! tiles a generated motion with pieces of a ground-truth (GT) clip.
 //!
 //! Everything works on [`PointClip`]s: per-frame sets of 3-D points, compared by the mean
 //! Euclidean distance of corresponding points (the reference's `pos_avg_l2`, "loc" mode). The

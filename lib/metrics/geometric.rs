@@ -1,5 +1,5 @@
 //! The 32 boolean geometric ("manual") features of Müller et al., as AIST++/Bailando and
-//! Motion2Motion's `utils/features/manual_new.py` compute them (`reference/motion2motion.md`
+//! Motion2Motion's `utils/features/manual_new.py` compute them (`docs/reference/motion2motion.md`
 //! §3.7): per frame, 32 relations between body parts (a hand in front of the body, a knee
 //! bent, a foot raised, a joint moving fast ...), averaged over frames into "fraction of frames
 //! true". FID over these vectors is Motion2Motion's FID_g.
@@ -241,7 +241,7 @@ enum Th {
     Hw(f64),
 }
 
-/// The reference's relations (`reference/motion2motion.md` §3.7).
+/// The reference's relations (`docs/reference/motion2motion.md` §3.7).
 #[derive(Clone, Copy)]
 enum Rel {
     /// Velocity of c relative to a, along a->b, above the threshold (d is ignored, as in the

@@ -1,5 +1,5 @@
 //! Kinetic features of one clip (AIST++/Bailando, as Motion2Motion's `utils/features/kinetic.py`
-//! computes them; `reference/motion2motion.md` §3.7): for every joint, the mean horizontal and
+//! computes them; `docs/reference/motion2motion.md` §3.7): for every joint, the mean horizontal and
 //! vertical kinetic energy (per unit mass) and the mean energy expenditure. FID over these
 //! vectors is Motion2Motion's FID_k.
 //!

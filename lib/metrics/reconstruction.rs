@@ -1,5 +1,5 @@
 //! Reconstruction and retargeting errors against a ground truth on the same skeleton (SATA,
-//! following SAME and SAN; `reference/papers/sata.txt` §4.1.3 and appendix D.2): JR, RT, JP,
+//! following SAME and SAN; SATA paper §4.1.3 and appendix D.2): JR, RT, JP,
 //! FS, GP and the character-normalised retargeting error. Definitions and deviations:
 //! `docs/metrics.md`.
 

@@ -1,4 +1,4 @@
-//! Motion transfer metrics of Motion2Motion (`reference/papers/motion2motion.txt` §4.2):
+//! Motion transfer metrics of Motion2Motion (paper §4.2):
 //! frequency alignment, contact consistency, diversity and throughput. The paper gives one
 //! sentence per metric and the reference code computes none of them, so the exact recipes are
 //! ours; `docs/metrics.md` states each choice.

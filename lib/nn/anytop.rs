@@ -1,5 +1,5 @@
-//! AnyTop's denoiser (paper §3.2, reference facts in anytop.md §2): predicts the clean motion
-//! x0 from a noised motion, the diffusion step and the skeleton.
+//! AnyTop's denoiser (paper §3.2, reference facts in docs/reference/anytop.md §2): predicts the
+//! clean motion x0 from a noised motion, the diffusion step and the skeleton.
 //!
 //! 1. Enrichment: each joint token is projected to `width` by its own linear (root and other
 //!    joints separately, the rest-pose token P_S at t = 0 separately from motion frames); the
@@ -12,7 +12,8 @@
 //!    the window; `x = LN3(x + FF(x))`. No final norm.
 //! 3. Output: root and other joints projected back to `feature_dims` by their own linears.
 //!
-//! Skeletal attention logits for head h, query joint i, key joint j (anytop.md §2.4):
+//! Skeletal attention logits for head h, query joint i, key joint j (docs/reference/anytop.md
+//! §2.4):
 //! `(q_i·k_j + q_i·EqD[D_ij] + k_i·EkD[D_ij] + q_i·EqR[R_ij] + k_i·EkR[R_ij]) / sqrt(head_dim)`.
 //! The key-side terms use k at the *query's* joint i, as the reference (GRPE's indexing) does;
 //! the paper's formula writes k_j. Because every bias term is then a function of (i, type), it

@@ -29,8 +29,8 @@ pub struct Batch {
     pub distances: Tensor,
     pub joint_mask: Tensor,
     pub frame_mask: Tensor,
-    /// Per-sample positions (the reference shares sample 0's crop start across the batch, §9.2;
-    /// we do not).
+    /// Per-sample positions (the reference shares sample 0's crop start across the batch,
+    /// docs/reference/anytop.md §9.2; we do not).
     pub positions: Tensor,
 }
 

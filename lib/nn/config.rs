@@ -4,7 +4,8 @@
 use super::NnError;
 use serde::{Deserialize, Serialize};
 
-/// Number of relation types in R (self, parent, child, sibling, none, end effector; §2.4).
+/// Number of relation types in R (self, parent, child, sibling, none, end effector;
+/// docs/reference/anytop.md §2.4).
 pub const RELATION_TYPES: usize = 6;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -34,8 +35,8 @@ pub struct DenoiserConfig {
 }
 
 impl DenoiserConfig {
-    /// The reference model (anytop.md §2.1): width 128, 4 layers, 4 heads, ff 1024, W 31,
-    /// d_max 5; names are 384-d MiniLM embeddings instead of 768-d T5.
+    /// The reference model (docs/reference/anytop.md §2.1): width 128, 4 layers, 4 heads, ff 1024,
+    /// W 31, d_max 5; names are 384-d MiniLM embeddings instead of 768-d T5.
     pub fn paper() -> DenoiserConfig {
         DenoiserConfig { width: 128, layers: 4, heads: 4, ff: 1024, window: 31, dmax: 5, name_dim: 384, feature_dims: 13, dropout: 0.0, ln_eps: 1e-5 }
     }
@@ -122,8 +123,8 @@ mod tests {
 
     #[test]
     fn paper_parameter_count_matches_the_reference_minus_unused_modules() {
-        // anytop.md §2.7: 1,762,714 effectively used parameters with 768-d T5 names; our names
-        // are 384-d, which removes 384 * 128 weights from the name projection.
+        // docs/reference/anytop.md §2.7: 1,762,714 effectively used parameters with 768-d T5 names;
+        // our names are 384-d, which removes 384 * 128 weights from the name projection.
         assert_eq!(DenoiserConfig::paper().parameter_count(), 1_762_714 - 384 * 128);
     }
 }

@@ -60,8 +60,9 @@ pub enum Keys {
     /// `types[(b * J + i) * J + k] = [a, b]` (distance type, relation type); `NO_TYPE` adds nothing.
     Topology { types: Arc<Vec<[u16; 2]>>, key_ok: Arc<Vec<bool>>, type_count: usize },
     /// Windowed temporal attention: key k is visible from query i when the token is real
-    /// (`frame_ok[b * T + k]`) and `k == 0` (the rest-pose token, §2.5) or `|i - k| <= half`.
-    /// The reference's window is [i-15, i+16], one wider on the right; we keep it symmetric.
+    /// (`frame_ok[b * T + k]`) and `k == 0` (the rest-pose token, docs/reference/anytop.md §2.5) or
+    /// `|i - k| <= half`. The reference's window is [i-15, i+16], one wider on the right; we keep
+    /// it symmetric.
     Window { half: usize, frame_ok: Arc<Vec<bool>> },
 }
 

@@ -106,9 +106,9 @@ impl FeedForward {
 }
 
 /// Sinusoidal embedding of positions (or diffusion steps) as the reference computes it
-/// (anytop.md §2.2): half = width/2, phi_i = p / 10000^(i/(half-1)), output `[cos phi, sin phi]`
-/// (cos block first). `positions` is f32 of any shape `S`; the result is `S x width`.
-/// Odd widths get one trailing zero column.
+/// (docs/reference/anytop.md §2.2): half = width/2, phi_i = p / 10000^(i/(half-1)),
+/// output `[cos phi, sin phi]` (cos block first). `positions` is f32 of any shape `S`; the
+/// result is `S x width`. Odd widths get one trailing zero column.
 pub fn sinusoid(positions: &Tensor, width: usize) -> Result<Tensor> {
     let half = width / 2;
     let device = positions.device();

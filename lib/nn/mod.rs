@@ -8,7 +8,7 @@
 //!   (candle's CPU RNG cannot be seeded), so the same seed gives the same model bytes;
 //! * [`batch`]: `Batch`, the tensors one forward pass needs, and `batch_from` which pads clips
 //!   of different skeletons and lengths into one batch;
-//! * [`anytop`]: the `Denoiser` (anytop.md §2, paper §3.2).
+//! * [`anytop`]: the `Denoiser` (docs/reference/anytop.md §2, paper §3.2).
 
 pub mod anytop;
 pub mod batch;

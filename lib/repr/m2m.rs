@@ -2,7 +2,7 @@
 //! position, with the root's horizontal position as per-frame velocities.
 //!
 //! `mo-retarget` matches and blends patches of these vectors, so they must be what the
-//! reference feeds its patch search (../shared/reference/motion2motion.md §3.1), and `mo-encode`
+//! reference feeds its patch search (docs/reference/motion2motion.md §3.1), and `mo-encode`
 //! must turn them back into the same motion. The paper states D = 6J + 3 per frame; the
 //! reference code lays the 6J rotation values (joints in file order) first, then the root
 //! position (x, y, z), with x and z turned into frame-to-frame differences and y kept absolute.
@@ -39,8 +39,8 @@
 //!   long clip (decoded positions stay within one float32 rounding step of the original).
 //! * No rescaling (the reference multiplies offsets and root positions by the target's
 //!   `1/ceil(max offset)`), no 120 -> 60 fps decimation and no detour through XYZ Euler angles:
-//!   tensors are in physical units at the clip's frame rate (DESIGN.md), and the rotation is
-//!   taken from the file's own channel order, which gives the same matrix.
+//!   tensors are in physical units at the clip's frame rate (docs/ARCHITECTURE.md), and the
+//!   rotation is taken from the file's own channel order, which gives the same matrix.
 //!
 //! # What it cannot carry
 //!

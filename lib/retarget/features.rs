@@ -6,8 +6,9 @@
 //! * root positions are multiplied by `scale` (the reference's `1 / ceil(max offset)` of the
 //!   target, with the sign fixed), so centimetre and metre skeletons weigh the same;
 //! * frame 0's dx/dz repeat frame 1's instead of holding an absolute position (the reference's
-//!   `v[0] = p[1]` quirk can blend a start position into a mid-clip frame, §4 "root handling").
-//!   The start position is kept aside and restored when decoding.
+//!   `v[0] = p[1]` quirk can blend a start position into a mid-clip frame,
+//!   docs/reference/motion2motion.md §4 "root handling"). The start position is kept aside and
+//!   restored when decoding.
 
 use super::settings::Repr;
 use crate::motion::Motion;

@@ -1,8 +1,8 @@
 //! Motion2Motion retargeting: transfer a motion to a skeleton of another topology from a few
-//! example clips of the target and a sparse binding (../shared/reference/papers/motion2motion.txt).
+//! example clips of the target and a sparse binding (the paper: docs/reference/README.md).
 //!
-//! The algorithm is the paper's (and the reference code's, ../shared/reference/motion2motion.md
-//! §3): per pyramid level, coarse to fine, the bound channels of the synthesis are set from the
+//! The algorithm is the paper's (and the reference code's, docs/reference/motion2motion.md §3):
+//! per pyramid level, coarse to fine, the bound channels of the synthesis are set from the
 //! source ("projection"), then `steps` times every patch of the synthesis is replaced by its
 //! nearest example patch (bound channels weigh `alpha`, the others `1 - alpha`) and the chosen
 //! patches are averaged. Unbound channels start as noise.

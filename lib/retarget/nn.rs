@@ -1,9 +1,9 @@
 //! Patch nearest neighbours and blending: one matching-and-blending step of Motion2Motion.
 //!
 //! A patch is `patch` consecutive frames of channel vectors; its distance to an example patch
-//! is the mean squared difference of the weighted values (reference §3.4). Instead of
-//! unfolding patches (`patch` times the data) and multiplying them, we use that a patch dot
-//! product is a sum of frame dot products along a diagonal:
+//! is the mean squared difference of the weighted values (docs/reference/motion2motion.md §3.4).
+//! Instead of unfolding patches (`patch` times the data) and multiplying them, we use that a patch
+//! dot product is a sum of frame dot products along a diagonal:
 //!
 //! `x_i . y_j = sum_k G(i + k, j + k)`, with `G = X Y^T` the frame-by-frame Gram matrix,
 //!

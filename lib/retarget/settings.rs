@@ -1,5 +1,5 @@
 //! Settings of a retarget run, with the paper's defaults (Motion2Motion §4.1, table 5) and the
-//! reference code's pyramid and noise values (../shared/reference/motion2motion.md §3.3).
+//! reference code's pyramid and noise values (docs/reference/motion2motion.md §3.3).
 
 use super::RetargetError;
 

@@ -1,4 +1,5 @@
-//! SATA: a topology-agnostic motion autoencoder (`reference/papers/sata.txt`; no public code).
+//! SATA: a topology-agnostic motion autoencoder (ICML 2026 paper, docs/reference/README.md; no
+//! public code).
 //!
 //! A clip of any skeleton is encoded into one latent vector per frame, and a latent sequence is
 //! decoded onto any skeleton given only its rest pose, topology and joint names: zero-shot

@@ -3,7 +3,8 @@
 //! Joint names feed a text embedding (AnyTop conditions on them) and name-based matching
 //! (bindings, feet, sides), so the many spellings of one body part should become one string:
 //! `LeftFoot`, `l_foot`, `Bip01_L_Foot`, `Foot_L`, `mixamorig:LeftFoot` and
-//! `Bip01_L_Foot__ouF` all normalise to "Left Foot". Rules, after AnyTop §1.11 and beyond it:
+//! `Bip01_L_Foot__ouF` all normalise to "Left Foot". Rules, after docs/reference/anytop.md §1.11
+//! and beyond it:
 //!
 //! 1. drop a namespace (`mixamorig:`) and a random Truebones suffix (`__xyz`);
 //! 2. split at `_ - . :` and spaces, before capitals (`LeftUpLeg`, `LHipJoint` -> L Hip Joint)

@@ -8,7 +8,7 @@ use super::names::{self, Side};
 use super::Skeleton;
 use glam::DVec3;
 
-/// AnyTop's foot words (reference/anytop.md §1.3.7): a joint whose lower-cased raw name
+/// AnyTop's foot words (docs/reference/anytop.md §1.3.7): a joint whose lower-cased raw name
 /// contains one of these is a foot candidate, and so are all of its descendants.
 const FOOT_WORDS: &[&str] = &["toe", "foot", "phalanx", "hoof", "ashi"];
 

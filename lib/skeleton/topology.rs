@@ -1,5 +1,5 @@
-//! Topology descriptors, exactly as AnyTop defines them (reference/anytop.md §2.4, paper §3.1),
-//! plus kinematic chains and end effectors.
+//! Topology descriptors, exactly as AnyTop defines them (docs/reference/anytop.md §2.4, paper
+//! §3.1), plus kinematic chains and end effectors.
 //!
 //! * Relations R (J x J), first matching rule wins: 0 self, 2 child (j's parent is i),
 //!   1 parent (i's parent is j), 3 sibling (same parent), 4 no relation; then the diagonal of

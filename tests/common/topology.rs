@@ -1,5 +1,5 @@
 //! Brute-force references for AnyTop's topology descriptors, written from the definition
-//! (reference/anytop.md §2.4) independently of lib/skeleton/topology.rs.
+//! (docs/reference/anytop.md §2.4) independently of lib/skeleton/topology.rs.
 
 /// Joint j, its parent, its grandparent, ... up to a root.
 pub fn ancestors(parents: &[Option<usize>], j: usize) -> Vec<usize> {

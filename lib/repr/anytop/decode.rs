@@ -1,4 +1,5 @@
-//! AnyTop features -> positions -> Motion on the original skeleton (§1.10).
+//! AnyTop features -> positions -> Motion on the original skeleton (docs/reference/anytop.md
+//! §1.10).
 
 use super::rig::Prepared;
 use super::{get3, get_6d, yaw_to_front, AnyTopError, AnyTopRig, IkOptions, Placement, DIMS_POSITION, DIMS_ROTATION, DIMS_VELOCITY, FEATURE_DIMS};

@@ -1,4 +1,4 @@
-//! Motion -> AnyTop features (§1.4–1.6; the table is in the module doc).
+//! Motion -> AnyTop features (docs/reference/anytop.md §1.4–1.6; the table is in the module doc).
 
 use super::rig::Prepared;
 use super::{

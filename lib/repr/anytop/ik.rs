@@ -1,14 +1,14 @@
 //! Inverse kinematics for decoding from positions: rotations of the natural rest pose that put
 //! every joint on its target.
 //!
-//! Like the reference (§1.10 step 4) joints are visited in index order (parents first) and each
-//! is rotated so that the directions to its children match the directions from its current
-//! position to their targets. Where the reference takes one averaged (log-mean) per-child
-//! rotation per visit and repeats whole passes up to 150 times, we solve each joint to
+//! Like the reference (docs/reference/anytop.md §1.10 step 4) joints are visited in index order
+//! (parents first) and each is rotated so that the directions to its children match the directions
+//! from its current position to their targets. Where the reference takes one averaged (log-mean)
+//! per-child rotation per visit and repeats whole passes up to 150 times, we solve each joint to
 //! convergence: the rotation minimising Σ_c ‖N·â_c − û_c‖² over its children c (unit rest and
-//! target directions, equal weights), by damped Gauss-Newton from the minimal swing that aims
-//! the longest child, stopping when the update is below `tolerance`. A joint's solution depends
-//! only on its ancestors', so one pass is the fixed point the reference's passes approach.
+//! target directions, equal weights), by damped Gauss-Newton from the minimal swing that aims the
+//! longest child, stopping when the update is below `tolerance`. A joint's solution depends only on
+//! its ancestors', so one pass is the fixed point the reference's passes approach.
 //!
 //! * One child: the minimal swing out of the natural rest pose (no twist, as the rest pose).
 //! * Children with collinear directions: the damping keeps the twist about their line at the

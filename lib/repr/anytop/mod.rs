@@ -1,6 +1,6 @@
 //! AnyTop's motion representation: 13 features per joint per frame, exact and invertible.
 //!
-//! AnyTop (reference/anytop.md §1, paper §3.1) represents a clip of any skeleton as a
+//! AnyTop (docs/reference/anytop.md §1, paper §3.1) represents a clip of any skeleton as a
 //! `[frames, joints, 13]` tensor: every joint is a token. Everything a model learns or a metric
 //! measures sees motion through this module, so encoding follows the reference closely, and
 //! decoding is exact: `decode(encode(m))` puts every joint back where it was.

@@ -1,5 +1,6 @@
-//! The per-skeleton quantities AnyTop computes from its rest ("T-pose") clip (§1.3–1.4), and
-//! the automatic choice of face joints that replaces AnyTop's per-species table.
+//! The per-skeleton quantities AnyTop computes from its rest ("T-pose") clip
+//! (docs/reference/anytop.md §1.3–1.4), and the automatic choice of face joints that replaces
+//! AnyTop's per-species table.
 //!
 //! Face joints, automatically. Left/right come from `roles::sides` (names, else geometry).
 //! A *limb* is a chain that leaves the body: a left or right joint whose parent is a centre

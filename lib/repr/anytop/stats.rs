@@ -1,4 +1,5 @@
-//! Per-skeleton normalisation statistics (§1.8), with the reference's std grouping.
+//! Per-skeleton normalisation statistics (docs/reference/anytop.md §1.8), with the reference's std
+//! grouping.
 //!
 //! * mean: per joint and feature, over every frame of every clip;
 //! * std: the population std per joint and feature, then grouped as the reference does since
