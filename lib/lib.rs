@@ -1,8 +1,40 @@
 //! menagerie: animate any skeleton from the command line.
 //!
-//! The library behind the binaries in `bins/`: data types and utilities at the bottom (`bvh`,
-//! `skeleton`, `motion`, `rng`, `linalg`), then documents and I/O (`document`, `io`), then
-//! tools (`synth`, `cli`).
+//! The library behind the binaries in `bins/`. Its modules stack in floors, each using only its
+//! own floor and those below; docs/ARCHITECTURE.md describes them, the formats between the tools
+//! and each tool's data flow, and docs/reference/ the facts taken from the reference code.
+//!
+//! Utilities:
+//! * [`rng`]: the seeded generator, independent streams and normal values behind all randomness.
+//! * [`linalg`]: dense symmetric linear algebra (eigenvalues, covariance, PSD square root) in f64.
+//! * [`budget`]: the memory budget an allocation sized from input is checked against first.
+//! * [`io`]: `-` as stdin/stdout, atomic all-or-nothing file output, NPY.
+//!
+//! Data types:
+//! * [`bvh`]: our BVH reader and writer (f64 values, exact round trip, file:line errors).
+//! * [`skeleton`]: the joint tree, topology (relations, distances, chains), names, sides, feet.
+//! * [`motion`]: per-frame local rotations and translations, Euler channels, forward kinematics.
+//! * [`repr`]: feature tensors of a motion (AnyTop's 13 per joint, Motion2Motion's) and back.
+//!
+//! Skeleton descriptions and edits:
+//! * [`document`]: the skeleton document (JSON) `skel-info` prints and the tools read.
+//! * [`embed`]: joint-name text embeddings, offline (a built-in MiniLM table).
+//! * [`binding`]: bone bindings between two skeletons, from a file or automatic.
+//! * [`augment`]: skeletal augmentation (remove chains, subdivide bones), motion kept exact.
+//!
+//! Algorithms:
+//! * [`nn`]: AnyTop's denoiser on candle (CPU).
+//! * [`diffusion`]: noise schedule, samplers, training data and loop, checkpoints, editing.
+//! * [`sata`]: the SATA topology-agnostic autoencoder (latents for any skeleton).
+//! * [`dift`]: diffusion features, joint and frame correspondence.
+//! * [`retarget`]: Motion2Motion retargeting (patch nearest neighbours over a pyramid).
+//! * [`metrics`]: the papers' metrics, movement and physics scores.
+//! * [`segment`]: temporal segmentation of a motion into actions.
+//! * [`render`]: contact sheets (PNG), GIF and an HTML viewer.
+//! * [`synth`]: procedural creatures and gaits, the project's own example data.
+//!
+//! Tools:
+//! * [`cli`]: what the binaries share: options, loading, output, one-line errors, exit codes.
 
 pub mod augment;
 pub mod binding;
