@@ -14,6 +14,7 @@ complete -c mo-train -l lambda-geo -d 'Weight of the geodesic rotation loss (the
 complete -c mo-train -l lambda-vel -d 'Weight of a velocity loss next to the MSE: the squared error of the prediction\'s frame-to-frame changes against the motion\'s (normalised units; MDM\'s, not in AnyTop\'s reference). 0 = off. Not kept in the checkpoint: give it again with --resume' -r
 complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3' -r
 complete -c mo-train -l augment-variants -d 'Augmented variants prepared per skeleton (alternately removing and adding joints)' -r
+complete -c mo-train -l ema -d 'anytop: decay of the moving average of the weights that the saved model holds and mo-sample samples with (the raw weights are kept beside it for --resume). 0 = save the raw weights. An average over about 1/(1 - decay) steps' -r
 complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this often' -r
 complete -c mo-train -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-train -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r

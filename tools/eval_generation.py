@@ -89,9 +89,14 @@ def sample(bindir, model, skeleton, out, n, frames, steps, sampler, seed):
     """Samples as BVH files in the new folder `out` (physics needs BVH); returns wall seconds."""
     os.makedirs(out)
     cmd = [f"{bindir}/mo-sample", skeleton, "-n", str(n), "--frames", str(frames), "--seed", str(seed), "-q",
-           "--steps", str(steps), "--sampler", sampler, "--bvh", os.path.join(out, "sample_{i}.bvh")]
-    # A model spec is a directory (or 'builtin') and optionally more mo-sample options after it.
+           "--bvh", os.path.join(out, "sample_{i}.bvh")]
+    # A model spec is a directory (or 'builtin') and optionally more mo-sample options after it;
+    # its own --steps / --sampler win over the table-wide ones.
     where, *extra = model.split()
+    if "--steps" not in extra:
+        cmd += ["--steps", str(steps)]
+    if "--sampler" not in extra:
+        cmd += ["--sampler", sampler]
     if where != "builtin":
         cmd += ["--model", where]
     cmd += extra

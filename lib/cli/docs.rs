@@ -1,7 +1,7 @@
 //! Man pages and shell completions, generated from the same clap commands that parse the
 //! arguments, so they cannot drift. They are committed under man/ and completions/ (users and
-//! packagers get them without building), and `tests/generated_docs.rs` fails when they are
-//! stale; `MENAGERIE_BLESS=1 cargo test --test generated_docs` rewrites them.
+//! packagers get them without building), and `tests/it/generated_docs.rs` fails when they are
+//! stale; `MENAGERIE_BLESS=1 cargo test --test it generated_docs` rewrites them.
 
 use clap_complete::Shell;
 

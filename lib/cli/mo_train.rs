@@ -109,6 +109,11 @@ pub struct Args {
     /// Augmented variants prepared per skeleton (alternately removing and adding joints).
     #[arg(long, value_name = "N", default_value_t = Augmentation::DEFAULT_VARIANTS as u64, value_parser = clap::value_parser!(u64).range(0..=64))]
     pub augment_variants: u64,
+    /// anytop: decay of the moving average of the weights that the saved model holds and
+    /// mo-sample samples with (the raw weights are kept beside it for --resume). 0 = save the
+    /// raw weights. An average over about 1/(1 - decay) steps.
+    #[arg(long, value_name = "DECAY", default_value_t = 0.999, value_parser = parse_decay)]
+    pub ema: f64,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
@@ -120,6 +125,16 @@ pub struct Args {
 }
 
 /// A probability: a decimal in [0, 1] or a fraction `a/b`.
+/// A moving-average decay: a number in [0, 1) (1 would never move).
+fn parse_decay(text: &str) -> Result<f64, String> {
+    let value: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number"))?;
+    if (0.0..1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("expected a decay in [0, 1), found {text}"))
+    }
+}
+
 fn parse_probability(text: &str) -> Result<f64, String> {
     let value = match text.split_once('/') {
         Some((a, b)) => {
@@ -238,6 +253,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 lambda_vel: args.lambda_vel,
                 augment: args.augment,
                 augment_variants: args.augment_variants as usize,
+                ema: args.ema,
             };
             // The checkpoint first: a resumed run must rebuild the data (augmented variants
             // included) from the seed the run started with.

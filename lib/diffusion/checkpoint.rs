@@ -4,7 +4,8 @@
 //! skeleton uses its own). Files are written beside their final names and renamed, so an
 //! interrupted save never leaves a partial file.
 
-use super::train::AdamW;
+use super::ema::{Ema, RAW_PREFIX};
+use super::train::{named_vars, AdamW};
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
 use crate::repr::anytop::AnyTopStats;
 use crate::skeleton::Skeleton;
@@ -109,6 +110,10 @@ pub struct CheckpointInfo {
     pub augment: f64,
     #[serde(default)]
     pub augment_variants: usize,
+    /// Decay of the weights' moving average that `model.safetensors` holds (`ema.rs`); 0 = the
+    /// raw weights (and checkpoints written before the average existed).
+    #[serde(default)]
+    pub ema: f64,
     pub skeletons: Vec<TrainedSkeleton>,
 }
 
@@ -118,11 +123,26 @@ pub struct CheckpointInfo {
 /// never a partial file (the renames themselves are atomic).
 /// Any model's checkpoint (`sata::checkpoint` uses it too): `info` is its `checkpoint.json`.
 pub fn save(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &AdamW) -> Result<(), CheckpointError> {
+    save_averaged(dir, info, varmap, opt, None)
+}
+
+/// `save`, with `model.safetensors` holding the weights' moving average `ema` when there is
+/// one, and the raw weights then kept in `optimizer.safetensors` for `--resume` (`ema.rs`).
+pub fn save_averaged(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &AdamW, ema: Option<&Ema>) -> Result<(), CheckpointError> {
     std::fs::create_dir_all(dir).map_err(CheckpointError::io(format!("cannot create {}", dir.display())))?;
     let tmp = |name: &str| dir.join(format!(".{name}.tmp"));
     let model = tmp("model.safetensors");
-    varmap.save(&model).map_err(CheckpointError::tensor(format!("cannot write {}", model.display())))?;
-    let state: std::collections::HashMap<String, candle_core::Tensor> = opt.state().into_iter().collect();
+    let mut state: std::collections::HashMap<String, candle_core::Tensor> = opt.state().into_iter().collect();
+    match ema {
+        None => varmap.save(&model).map_err(CheckpointError::tensor(format!("cannot write {}", model.display())))?,
+        Some(ema) => {
+            let weights: std::collections::HashMap<&str, candle_core::Tensor> = ema.weights().iter().map(|(k, t)| (k.as_str(), t.clone())).collect();
+            candle_core::safetensors::save(&weights, &model).map_err(CheckpointError::tensor(format!("cannot write {}", model.display())))?;
+            for (name, var) in named_vars(varmap) {
+                state.insert(format!("{RAW_PREFIX}{name}"), var.as_tensor().clone());
+            }
+        }
+    }
     let optimizer = tmp("optimizer.safetensors");
     candle_core::safetensors::save(&state, &optimizer).map_err(CheckpointError::tensor(format!("cannot write {}", optimizer.display())))?;
     let text = serde_json::to_string_pretty(info).map_err(CheckpointError::json("serialising the checkpoint info".into()))?;
@@ -234,6 +254,14 @@ pub fn frozen_default(device: &Device) -> Result<Frozen, CheckpointError> {
     const INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
     const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");
     frozen_bytes(INFO, WEIGHTS, device).map_err(CheckpointError::of("the built-in default model".into()))
+}
+
+/// The raw weights an averaged checkpoint keeps beside its optimiser state (`w.<name>`), by
+/// parameter name; empty for a checkpoint written without an average.
+pub fn load_raw_weights(dir: &Path, device: &Device) -> Result<std::collections::HashMap<String, candle_core::Tensor>, CheckpointError> {
+    let path = dir.join("optimizer.safetensors");
+    let tensors = candle_core::safetensors::load(&path, device).map_err(CheckpointError::tensor(format!("cannot load {}", path.display())))?;
+    Ok(tensors.into_iter().filter_map(|(k, t)| k.strip_prefix(RAW_PREFIX).map(|n| (n.to_string(), t))).collect())
 }
 
 /// The optimiser state saved beside a checkpoint.

@@ -5,6 +5,7 @@ pub mod checkpoint;
 pub mod condition;
 pub mod data;
 pub mod edit;
+pub mod ema;
 pub mod sample;
 pub mod schedule;
 pub mod train;

@@ -8,6 +8,7 @@
 
 use super::checkpoint::{self, CheckpointInfo, TrainedSkeleton};
 use super::data::TrainSet;
+use super::ema::Ema;
 use super::train::{named_vars, train_step, AdamW};
 use super::Schedule;
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
@@ -224,12 +225,17 @@ pub struct AnyTopOptions {
     pub lambda_vel: f64,
     pub augment: f64,
     pub augment_variants: usize,
+    /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
+    /// 0 = none.
+    pub ema: f64,
 }
 
 /// A denoiser checkpoint to continue, with its optimiser state.
 pub struct AnyTopResume {
     loaded: checkpoint::Loaded,
     opt: AdamW,
+    /// The raw weights of an averaged checkpoint (its `model.safetensors` holds the average).
+    raw: std::collections::HashMap<String, candle_core::Tensor>,
 }
 
 impl AnyTopResume {
@@ -237,7 +243,8 @@ impl AnyTopResume {
     pub fn load(dir: &Path, lr: f64, device: &Device) -> Result<AnyTopResume, TrainError> {
         let loaded = checkpoint::load(dir, device)?;
         let opt = checkpoint::load_optimizer(dir, loaded.info.step, device, lr)?;
-        Ok(AnyTopResume { loaded, opt })
+        let raw = checkpoint::load_raw_weights(dir, device)?;
+        Ok(AnyTopResume { loaded, opt, raw })
     }
 
     /// The training data must be rebuilt (augmented variants included) from the seed and
@@ -268,6 +275,7 @@ pub struct AnyTopTrainer {
     crop: usize,
     lambda_geo: f64,
     lambda_vel: f64,
+    ema: Option<Ema>,
     device: Device,
 }
 
@@ -277,8 +285,8 @@ impl AnyTopTrainer {
     /// `topology::DEFAULT_DMAX`, a resumed one's with its checkpoint's.
     pub fn new(out: &Path, opts: &AnyTopOptions, resume: Option<AnyTopResume>, set: TrainSet, device: &Device) -> Result<AnyTopTrainer, TrainError> {
         let schedule = Schedule::cosine(100);
-        let (varmap, model, opt, mut info) = match resume {
-            Some(r) => (r.loaded.varmap, r.loaded.model, r.opt, r.loaded.info),
+        let (varmap, model, opt, mut info, raw) = match resume {
+            Some(r) => (r.loaded.varmap, r.loaded.model, r.opt, r.loaded.info, r.raw),
             None => {
                 refuse_existing(out)?;
                 let varmap = VarMap::new();
@@ -296,9 +304,10 @@ impl AnyTopTrainer {
                     dmax: crate::skeleton::topology::DEFAULT_DMAX,
                     augment: 0.0,
                     augment_variants: 0,
+                    ema: 0.0,
                     skeletons: Vec::new(),
                 };
-                (varmap, model, AdamW::new(opts.lr), info)
+                (varmap, model, AdamW::new(opts.lr), info, Default::default())
             }
         };
         info.augment = opts.augment;
@@ -316,6 +325,23 @@ impl AnyTopTrainer {
             })
             .collect();
         let vars = named_vars(&varmap);
+        // The loaded weights are the average (or the raw weights of a checkpoint without one):
+        // the average continues from them, training from the raw weights kept beside them.
+        let ema = if opts.ema > 0.0 { Some(Ema::new(opts.ema, &vars).map_err(NnError::from)?) } else { None };
+        for (name, var) in &vars {
+            if let Some(w) = raw.get(name) {
+                if w.dims() != var.dims() {
+                    return Err(checkpoint::CheckpointError::Invalid(format!(
+                        "optimizer.safetensors: raw weight {name} is {:?}, the model's is {:?}",
+                        w.dims(),
+                        var.dims()
+                    ))
+                    .into());
+                }
+                var.set(w).map_err(NnError::from)?;
+            }
+        }
+        info.ema = opts.ema;
         Ok(AnyTopTrainer {
             out: out.to_path_buf(),
             info,
@@ -329,6 +355,7 @@ impl AnyTopTrainer {
             crop: opts.crop,
             lambda_geo: opts.lambda_geo,
             lambda_vel: opts.lambda_vel,
+            ema,
             device: device.clone(),
         })
     }
@@ -355,12 +382,17 @@ impl Trainer for AnyTopTrainer {
             self.lambda_vel,
             &self.device,
         )?;
+        if stats.loss.is_finite() {
+            if let Some(ema) = self.ema.as_mut() {
+                ema.update(&self.vars, k).map_err(NnError::from)?;
+            }
+        }
         Ok(StepLosses { total: stats.loss, parts: Vec::new() })
     }
 
     fn save(&mut self, steps: u64) -> Result<(), TrainError> {
         self.info.step = steps;
-        Ok(checkpoint::save(&self.out, &self.info, &self.varmap, &self.opt)?)
+        Ok(checkpoint::save_averaged(&self.out, &self.info, &self.varmap, &self.opt, self.ema.as_ref())?)
     }
 }
 

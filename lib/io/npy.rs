@@ -15,7 +15,7 @@
 //!   with the dtype found and the dtype expected. The header is bounded (`MAX_HEADER_BYTES`),
 //!   shapes whose element count overflows or disagrees with the data are refused, and data is
 //!   read incrementally, so a lying header cannot make us allocate more than the input holds.
-//!   No input makes it panic (a seeded mutation test in `tests/npy.rs` checks this).
+//!   No input makes it panic (a seeded mutation test in `tests/it/npy.rs` checks this).
 
 use std::io::{self, Read, Write};
 

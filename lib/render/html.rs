@@ -10,7 +10,7 @@
 //! and predicted from the previous frame(s) of the same series, so what deflate sees is mostly
 //! small residuals in two byte planes. Real 30 fps mocap takes about 1.4-2.1 bytes per point
 //! and frame after base64 (faster motion costs more), so a 5000-frame, 115-point clip makes a
-//! page of about 0.8-1.2 MB (`cargo test --test render_html -- --ignored --nocapture` measures
+//! page of about 0.8-1.2 MB (`cargo test --test it render_html -- --ignored --nocapture` measures
 //! it on the corpus).
 //!
 //! The page also carries a self test: opened with `#selftest` it draws two frames, counts the

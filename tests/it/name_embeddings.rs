@@ -1,7 +1,7 @@
 //! Joint-name embeddings (lib/embed.rs): the compiled-in MiniLM table, composition of names it
 //! lacks, and coverage of our example creatures and (when present) the real corpus.
 
-mod common;
+use crate::common;
 
 use menagerie::embed::{cosine, dequantise_i8, hash_unit_vector, quantise_i8, NameTable, Source};
 use menagerie::skeleton::names::normalise;
@@ -185,7 +185,7 @@ fn quantisation_round_trip_within_bound() {
 fn malformed_tables_are_errors() {
     assert!(NameTable::from_bytes(b"").is_err());
     assert!(NameTable::from_bytes(b"NOTMAGIC\0\0\0\0").is_err());
-    let good = include_bytes!("../assets/name_embeddings.bin");
+    let good = include_bytes!("../../assets/name_embeddings.bin");
     assert!(NameTable::from_bytes(&good[..good.len() - 1]).is_err(), "truncated");
     let mut extra = good.to_vec();
     extra.push(0);

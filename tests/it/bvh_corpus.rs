@@ -1,6 +1,6 @@
 //! The BVH reader and writer on every real corpus file: everything parses, joint counts match
 //! the ROOT/JOINT entries, and the write-back round trip is exact.
-mod common;
+use crate::common;
 
 use menagerie::bvh;
 

@@ -13,7 +13,7 @@
 //! * bad input exits 2 with one line and leaves no file behind.
 //!
 //! The worst errors are printed (run with `--nocapture`).
-mod common;
+use crate::common;
 
 use common::{check_failure, load, ok, s, tempdir};
 
@@ -50,7 +50,7 @@ fn read_document(path: &Path) -> SkeletonDocument {
     SkeletonDocument::from_json(&std::fs::read_to_string(path).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
-/// The creature's size for tolerances (as tests/anytop_repr.rs): the vertical extent of frame
+/// The creature's size for tolerances (as tests/it/anytop_repr.rs): the vertical extent of frame
 /// 0 (joints and End Sites), or the rest extent for a flat creature (a snake on the ground).
 fn size(skeleton: &Skeleton, motion: &Motion) -> f64 {
     let n = skeleton.len();
@@ -260,7 +260,7 @@ fn python_numpy() -> bool {
 #[test]
 fn numpy_loads_anytop_tensors() {
     if !python_numpy() {
-        eprintln!("SKIP numpy_loads_anytop_tensors: python3 with numpy is not available");
+        common::skip("numpy_loads_anytop_tensors", "python3 with numpy is not available");
         return;
     }
     let dir = tempdir("numpy");

@@ -1,6 +1,6 @@
 //! Malformed BVH input: every case exits 2 with one line on stderr that names the file and the
 //! line where the problem is, and says what was expected. No panics, no output.
-mod common;
+use crate::common;
 
 /// A valid two-joint file, line by line, that the cases below break in one place each.
 const GOOD: &[&str] = &[

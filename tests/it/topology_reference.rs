@@ -10,7 +10,7 @@
 //!
 //! On every corpus file (skipped without ../shared/data), every synthetic creature in
 //! examples/data, and programmatic skeletons of up to 143 joints (AnyTop's largest).
-mod common;
+use crate::common;
 
 use common::topology::{reference_distances, reference_relations};
 

@@ -3,7 +3,7 @@
 //! mean and std. Needs python3 with numpy and scipy (`python3 -m pip install numpy scipy`);
 //! prints a SKIP line and passes without them. `MENAGERIE_PYTHON` picks another interpreter.
 
-mod common;
+use crate::common;
 
 use menagerie::metrics::fid::{fid, FidOptions};
 use menagerie::rng::SplitMix64;
@@ -46,13 +46,13 @@ fn textbook(tag: &str, cases: &[Case]) -> Option<Vec<f64>> {
     let script = dir.join("fid.py");
     std::fs::write(&script, TEXTBOOK).unwrap();
     let Ok(out) = Command::new(python()).arg(&script).arg(&data).output() else {
-        eprintln!("SKIP {tag}: cannot run {} (install python3 with numpy and scipy)", python());
+        common::skip(tag, &format!("cannot run {} (install python3 with numpy and scipy)", python()));
         return None;
     };
     assert!(out.status.success(), "python failed: {}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
     if text.starts_with("MISSING") {
-        eprintln!("SKIP {tag}: {} lacks numpy or scipy ({}); python3 -m pip install numpy scipy", python(), text.trim());
+        common::skip(tag, &format!("{} lacks numpy or scipy ({}); python3 -m pip install numpy scipy", python(), text.trim()));
         return None;
     }
     let values: Vec<f64> = text.lines().map(|l| l.trim().parse().unwrap_or_else(|e| panic!("python printed {l:?}: {e}"))).collect();

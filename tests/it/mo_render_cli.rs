@@ -1,7 +1,7 @@
 //! `mo-render` end to end: every synthetic creature draws to a PNG sheet and a GIF of the
 //! expected geometry, several motions stack, NPY + skeleton draws like the BVH it came from,
 //! output is deterministic, and bad input exits 2 without leaving a file.
-mod common;
+use crate::common;
 
 use common::{check_failure, example_bvh_files, ok, run, s, tempdir};
 use std::path::Path;

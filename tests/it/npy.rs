@@ -3,6 +3,7 @@
 //! through a pipe-like reader that returns a few bytes at a time, and no mutation of a valid
 //! file makes the reader panic. The numpy checks print SKIP when python3 + numpy are absent.
 
+use crate::common;
 use menagerie::io::npy::{self, NpyArray, NpyError};
 use std::io::Read;
 use std::path::PathBuf;
@@ -44,7 +45,7 @@ fn shapes() -> Vec<Vec<usize>> {
 #[test]
 fn numpy_loads_what_we_write_byte_for_byte() {
     if !python_numpy() {
-        eprintln!("SKIP numpy_loads_what_we_write_byte_for_byte: python3 with numpy is not available");
+        common::skip("numpy_loads_what_we_write_byte_for_byte", "python3 with numpy is not available");
         return;
     }
     let dir = tempdir("write");
@@ -80,7 +81,7 @@ fn numpy_loads_what_we_write_byte_for_byte() {
 #[test]
 fn we_read_what_numpy_writes() {
     if !python_numpy() {
-        eprintln!("SKIP we_read_what_numpy_writes: python3 with numpy is not available");
+        common::skip("we_read_what_numpy_writes", "python3 with numpy is not available");
         return;
     }
     let dir = tempdir("read");

@@ -2,7 +2,7 @@
 //! names, and a name trap: CMU's LeftShoulder is Xia's LeftArm), Mixamo Joe vs Malcolm, a
 //! skeleton vs its skel-aug variants, and Flamingo -> Monkey (legs to legs, left to left).
 //! The issue asks for at least 90% correct pairs.
-mod common;
+use crate::common;
 
 use menagerie::binding::auto::{auto_bind, AutoOptions, Body, Choice};
 use menagerie::document::AnyTopSection;

@@ -1,7 +1,7 @@
 //! AnyTop representation: exact round trips on every frame of every corpus file and example
 //! creature, the reference's invariants (docs/reference/anytop.md §1.6) on real clips, rig
 //! serialisation, statistics. The worst errors are printed (run with `--nocapture`).
-mod common;
+use crate::common;
 
 use menagerie::bvh;
 use menagerie::motion::Motion;

@@ -2,7 +2,7 @@
 //! in-betweening and body-part editing keep the reference's values (in physical units), the
 //! generated part depends on the seed and only on it, `--report` gives seam jumps, and bad
 //! ranges, unknown joints and a reference of another skeleton exit 2 without output.
-mod common;
+use crate::common;
 
 use common::{check_failure, ok, run, s, tempdir};
 use menagerie::io::npy;

@@ -3,7 +3,7 @@
 //! file whose bones do not translate, and the decoded BVH re-encodes to the same features;
 //! batches stack or fail clearly; output does not depend on --threads; bad input exits 2 with
 //! one line and leaves no file behind.
-mod common;
+use crate::common;
 
 use common::{check_failure, load, ok, s, tempdir};
 
@@ -148,7 +148,7 @@ fn corpus_round_trips_within_1e4_of_the_size() {
 #[test]
 fn numpy_loads_the_encoded_tensor() {
     if !common_python() {
-        eprintln!("SKIP numpy_loads_the_encoded_tensor: python3 with numpy is not available");
+        common::skip("numpy_loads_the_encoded_tensor", "python3 with numpy is not available");
         return;
     }
     let dir = tempdir("numpy");

@@ -4,7 +4,7 @@
 //!
 //! Skipped (with a printed SKIP line) when no Chromium is installed; CI installs Debian's `chromium`.
 
-mod common;
+use crate::common;
 
 use menagerie::bvh;
 use menagerie::motion::Motion;
@@ -165,7 +165,7 @@ fn check(result: &serde_json::Value, what: &str) {
 #[test]
 fn viewer_draws_moving_skeletons_in_chromium() {
     let Some(chromium) = find_chromium() else {
-        eprintln!("SKIP viewer_draws_moving_skeletons_in_chromium: chromium not found (install Debian's chromium)");
+        common::skip("viewer_draws_moving_skeletons_in_chromium", "chromium not found (install Debian's chromium)");
         return;
     };
     let dir = Scratch::new("browser");
@@ -204,7 +204,7 @@ fn viewer_draws_moving_skeletons_in_chromium() {
 }
 
 /// Size and error on real long clips. Measurement, not a gate: run with
-/// `cargo test --release --test render_html -- --ignored --nocapture`.
+/// `cargo test --release --test it render_html -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn measure_page_size_on_corpus() {

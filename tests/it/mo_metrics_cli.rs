@@ -1,7 +1,7 @@
 //! `mo-metrics` end to end, with answers known in advance: a motion against itself scores
 //! perfectly in every subcommand, physics runs on every creature and every corpus file without
 //! a non-finite number, and bad input exits 2 with one line.
-mod common;
+use crate::common;
 
 use common::{check_failure, example_bvh_files, ok, run, s, shared_data, tempdir};
 use serde_json::Value;

@@ -1,6 +1,6 @@
 //! The latent model (SATA) end to end: `mo-encode --latent` / `--decode-latent`, `mo-retarget
 //! --method latent`, `mo-train --arch sata` with resume; bad inputs exit 2 without output.
-mod common;
+use crate::common;
 
 use common::{check_failure, ok, run, s, tempdir};
 use menagerie::io::npy;

@@ -1,5 +1,5 @@
 //! Committed man pages and completions must match what the clap definitions generate now.
-//! Regenerate with `MENAGERIE_BLESS=1 cargo test --test generated_docs`.
+//! Regenerate with `MENAGERIE_BLESS=1 cargo test --test it generated_docs`.
 
 use std::path::Path;
 
@@ -20,5 +20,5 @@ fn man_pages_and_completions_are_fresh() {
             _ => stale.push(rel),
         }
     }
-    assert!(stale.is_empty(), "stale generated files (run `MENAGERIE_BLESS=1 cargo test --test generated_docs`): {stale:?}");
+    assert!(stale.is_empty(), "stale generated files (run `MENAGERIE_BLESS=1 cargo test --test it generated_docs`): {stale:?}");
 }

@@ -1,6 +1,6 @@
 //! Motion metrics (physics, kinetic and geometric features, reconstruction, transfer) on real
 //! files: our synthetic creatures for known answers, the shared corpus for "runs everywhere".
-mod common;
+use crate::common;
 
 use glam::{DQuat, DVec3};
 use menagerie::bvh;

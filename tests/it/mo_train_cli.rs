@@ -1,7 +1,7 @@
 //! `mo-train` as a process: Ctrl-C / SIGTERM save a checkpoint at a step boundary and exit 130,
 //! and resuming from it ends where the uninterrupted run ends; the augmentation flags and the
 //! recorded skeleton names.
-mod common;
+use crate::common;
 
 use common::{bin, ok, run, s, tempdir};
 use std::path::{Path, PathBuf};
@@ -126,5 +126,39 @@ fn a_non_finite_loss_stops_and_keeps_the_last_checkpoint() {
             let value: serde_json::Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{arch}: {line}: {e}"));
             assert!(value["loss"].as_f64().is_some_and(f64::is_finite), "{arch}: {line}");
         }
+    }
+}
+
+/// The saved model is the weights' moving average and the raw weights are kept beside the
+/// optimiser's moments for --resume; `--ema 0` saves the raw weights and keeps no copy.
+#[test]
+fn the_saved_model_is_the_moving_average_of_the_weights() {
+    let dir = tempdir("train-ema");
+    let data = data(&dir);
+    let load = |p: PathBuf| candle_core::safetensors::load(p, &candle_core::Device::Cpu).unwrap();
+    let flat = |t: &candle_core::Tensor| t.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+    let averaged = dir.join("averaged");
+    let mut args = train_args(&data, &averaged, "4");
+    args.extend(["--ema", "0.5"]);
+    ok(&run("mo-train", &args, None), "ema 0.5");
+    assert_eq!(info(&averaged)["ema"].as_f64(), Some(0.5));
+    let (model, state) = (load(averaged.join("model.safetensors")), load(averaged.join("optimizer.safetensors")));
+    let mut differ = 0;
+    for (name, w) in &model {
+        let raw = state.get(&format!("w.{name}")).unwrap_or_else(|| panic!("no raw copy of {name}"));
+        assert_eq!(raw.dims(), w.dims(), "{name}");
+        differ += usize::from(flat(raw) != flat(w));
+    }
+    assert!(differ > model.len() / 2, "the average equals the raw weights for {} of {} parameters", model.len() - differ, model.len());
+    let plain = dir.join("plain");
+    let mut args = train_args(&data, &plain, "4");
+    args.extend(["--ema", "0"]);
+    ok(&run("mo-train", &args, None), "ema 0");
+    assert!(load(plain.join("optimizer.safetensors")).keys().all(|k| !k.starts_with("w.")));
+    // The raw weights of the averaged run are those of the plain run: the average never feeds
+    // back into training.
+    let (raw_plain, raw_avg) = (load(plain.join("model.safetensors")), state);
+    for (name, w) in &raw_plain {
+        assert_eq!(flat(w), flat(&raw_avg[&format!("w.{name}")]), "{name}");
     }
 }

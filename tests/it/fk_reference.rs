@@ -11,7 +11,7 @@
 //!   pass when either is missing. `MENAGERIE_PYTHON` picks another interpreter.
 //! * `MENAGERIE_REGEN_FIXTURES=1` rewrites the handmade fixture from bvhfk (only needed if the
 //!   handmade BVH below is changed).
-mod common;
+use crate::common;
 
 use menagerie::bvh;
 use menagerie::bvh::Channel;
@@ -128,20 +128,18 @@ fn manifest() -> &'static Path {
 fn reference_python(test: &str) -> Option<(String, PathBuf)> {
     let tools = manifest().join("../shared/tools");
     if !tools.join("bvhfk.py").is_file() {
-        eprintln!("SKIP {test}: ../shared/tools/bvhfk.py is absent");
+        common::skip(test, "../shared/tools/bvhfk.py is absent");
         return None;
     }
     let python = std::env::var("MENAGERIE_PYTHON").unwrap_or_else(|_| "python3".to_string());
     match Command::new(&python).args(["-c", "import numpy"]).output() {
         Ok(out) if out.status.success() => Some((python, tools)),
         Ok(_) => {
-            let why = format!("SKIP {test}: {python} has no numpy (python3 -m pip install numpy)");
-            eprintln!("{why}");
+            common::skip(test, &format!("{python} has no numpy (python3 -m pip install numpy)"));
             None
         }
         Err(e) => {
-            let why = format!("SKIP {test}: cannot run {python}: {e}");
-            eprintln!("{why}");
+            common::skip(test, &format!("cannot run {python}: {e}"));
             None
         }
     }
@@ -248,7 +246,7 @@ fn handmade_fixture_is_what_bvhfk_computes() {
     let r = dump.pop().unwrap();
     assert!(r.error.is_none(), "bvhfk on the handmade BVH: {:?}", r.error);
     let fresh = Fixture {
-        about: "bvhfk.py (../shared/tools) world positions for the handmade BVH in tests/fk_reference.rs, \
+        about: "bvhfk.py (../shared/tools) world positions for the handmade BVH in tests/it/fk_reference.rs, \
                 every frame, joints in file order; height = bvhfk's height() (largest extent of frame 0)"
             .to_string(),
         bvh: HANDMADE_BVH.to_string(),

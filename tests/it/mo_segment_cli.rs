@@ -1,7 +1,7 @@
 //! `mo-segment` end to end: finds the boundaries of a synthetic walk-stop-walk clip, is
 //! deterministic, reads `mo-encode`'s NPY like the BVH, feeds `mo-render --frame-labels`, and
 //! fails cleanly on bad input.
-mod common;
+use crate::common;
 
 use common::{check_failure, ok, run, s, tempdir};
 use menagerie::synth::{training_clip, Action};

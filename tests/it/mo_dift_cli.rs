@@ -3,7 +3,7 @@
 //! most surviving joints; `--as-binding` writes a binding that `mo-retarget` accepts; frame
 //! matching of a clip with itself is the identity, and against a time-warped copy recovers the
 //! warp; bad inputs exit 2 without output.
-mod common;
+use crate::common;
 
 use common::{check_failure, ok, run, s, tempdir};
 use menagerie::binding::Binding;

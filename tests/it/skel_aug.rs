@@ -10,7 +10,7 @@
 //! * through the binary: the same seed gives byte-identical output, variants differ, a
 //!   skeleton document comes back as a document that passes the JSON Schema and describes the
 //!   same skeleton as the BVH path; bad input exits 2 with one line and no file.
-mod common;
+use crate::common;
 
 use common::{schema_validator, tempdir};
 

@@ -1,7 +1,7 @@
 //! `mo-retarget` end to end: the Motion2Motion demo with the reference's binding and with
 //! `--bind auto`, determinism and diverse samples, output lengths, frame-rate handling, and
 //! every bad input the issue lists (one line, exit 2, no file).
-mod common;
+use crate::common;
 
 use common::{check_failure, load, ok, run, s, shared_data, tempdir};
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! `skel-info` end to end: documents for every corpus and example file pass the JSON Schema,
 //! carry the right joint counts and give back the exact BVH hierarchy; stdin, several files,
 //! text output, broken pipes and atomic output behave as docs/ARCHITECTURE.md promises.
-mod common;
+use crate::common;
 
 use common::{schema_validator, tempdir};
 

@@ -13,9 +13,18 @@ pub fn shared_data(test: &str) -> Option<PathBuf> {
     if dir.join("bvh").is_dir() {
         Some(dir)
     } else {
-        eprintln!("SKIP {test}: ../shared/data is absent (corpus tests need it)");
+        skip(test, "../shared/data is absent (corpus tests need it)");
         None
     }
+}
+
+/// Say why `test` is skipped. Under `MENAGERIE_REQUIRE_ALL=1` (set by `.ci/run`) a skip is a
+/// failure instead: CI must not go green with the corpus, numpy, scipy or Chromium missing.
+pub fn skip(test: &str, why: &str) {
+    if std::env::var_os("MENAGERIE_REQUIRE_ALL").is_some_and(|v| v == "1") {
+        panic!("{test} cannot run ({why}) and MENAGERIE_REQUIRE_ALL=1 forbids skipping it");
+    }
+    eprintln!("SKIP {test}: {why}");
 }
 
 /// Every BVH file of the corpus, sorted.

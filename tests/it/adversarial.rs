@@ -6,7 +6,7 @@
 //!
 //! Device nodes are private ones made with mknod in a scratch directory (root only; skipped
 //! with a printed reason otherwise). Nothing here ever names anything in /dev.
-mod common;
+use crate::common;
 
 use common::{run, s, tempdir};
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! `mo-train` and `mo-sample` end to end on the bundled creatures (tiny model, a few steps):
 //! an interrupted-and-resumed run equals the straight run byte for byte, sampling is
 //! deterministic, works for a skeleton never trained on, and bad input exits 2.
-mod common;
+use crate::common;
 
 use common::{check_failure, ok, run, s, tempdir};
 use std::path::Path;
