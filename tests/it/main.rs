@@ -1,11 +1,11 @@
 //! All integration tests in one harness (one binary to build and link instead of one per file).
 //! Run one module with `cargo test --test it <module>::`.
 
-mod common;
 mod adversarial;
 mod anytop_repr;
 mod auto_binding;
 mod bvh_corpus;
+mod common;
 mod fk_reference;
 mod generated_docs;
 mod help_examples;
