@@ -102,7 +102,7 @@ impl MiniLm {
         if cfg.max_position_embeddings < 2 || cfg.vocab_size == 0 || cfg.hidden_size == 0 {
             return Err(bad("config.json", "hidden_size, vocab_size must be > 0 and max_position_embeddings >= 2".into()));
         }
-        if cfg.num_attention_heads == 0 || cfg.hidden_size % cfg.num_attention_heads != 0 {
+        if cfg.num_attention_heads == 0 || !cfg.hidden_size.is_multiple_of(cfg.num_attention_heads) {
             return Err(bad("config.json", format!("hidden_size {} not divisible by {} heads", cfg.hidden_size, cfg.num_attention_heads)));
         }
         let tok: TokenizerFile = serde_json::from_slice(&read("tokenizer.json")?).map_err(|e| bad("tokenizer.json", e.to_string()))?;

@@ -46,7 +46,7 @@ pub struct PointFeatures {
 impl PointClip {
     /// `frames × dims` values, row-major; `dims` must be a positive multiple of 3 (points).
     pub fn new(frames: usize, dims: usize, values: Vec<f64>) -> Result<PointClip, MetricError> {
-        if dims == 0 || dims % 3 != 0 {
+        if dims == 0 || !dims.is_multiple_of(3) {
             return Err(MetricError::Mismatch(format!("point clip: {dims} values per frame is not a positive multiple of 3")));
         }
         if values.len() != frames * dims {

@@ -212,7 +212,7 @@ impl<'a> Reference<'a> {
         let mut k = 0usize;
         for (ci, c) in clips.iter().enumerate() {
             for f in 0..c.frames {
-                if k % stride == 0 {
+                if k.is_multiple_of(stride) {
                     poses.push((ci, pose_descriptor(c.frame(f), c.scale)));
                 }
                 k += 1;

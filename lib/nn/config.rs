@@ -60,7 +60,7 @@ impl DenoiserConfig {
         if self.width == 0 || self.layers == 0 || self.ff == 0 || self.feature_dims == 0 || self.name_dim == 0 {
             return bad("width/layers/ff/feature_dims/name_dim", format!("all must be > 0, got {self:?}"));
         }
-        if self.heads == 0 || self.width % self.heads != 0 {
+        if self.heads == 0 || !self.width.is_multiple_of(self.heads) {
             return bad("heads", format!("must divide width {}, got {}", self.width, self.heads));
         }
         if self.width < 2 {

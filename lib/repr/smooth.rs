@@ -17,6 +17,7 @@
 //! 2. the offset between kept and generated motion, known on the kept frames and 0 elsewhere,
 //!    is smoothed with the kept frames pinned and λ for a half-response at a period of 2B:
 //!    a correction that equals the offset on the kept frames and fades over about B frames.
+//!
 //! Generated frames are (1) + (2): the generated motion's own detail, shifted onto the kept
 //! motion near the seams with matching velocity.
 //!
@@ -288,7 +289,7 @@ mod tests {
         for (k, v) in f.data.iter_mut().enumerate() {
             // Deterministic, rough: a slow wave plus a frame-to-frame sawtooth.
             let t = (k / (joints * dims)) as f64;
-            *v = ((t * 0.2 + k as f64 * 0.37).sin() + if t as usize % 2 == 0 { 0.3 } else { -0.3 }) as f32;
+            *v = ((t * 0.2 + k as f64 * 0.37).sin() + if (t as usize).is_multiple_of(2) { 0.3 } else { -0.3 }) as f32;
         }
         f
     }

@@ -130,7 +130,7 @@ impl SataConfig {
         if self.width < 2 || self.blocks == 0 || self.ff == 0 || self.latent == 0 || self.frequencies == 0 || self.name_dim == 0 {
             return bad("width/blocks/ff/latent/frequencies/name_dim", format!("all must be > 0 (width >= 2), got {self:?}"));
         }
-        if self.heads == 0 || self.width % self.heads != 0 {
+        if self.heads == 0 || !self.width.is_multiple_of(self.heads) {
             return bad("heads", format!("must divide width {}, got {}", self.width, self.heads));
         }
         if self.window < 2 || self.overlap * 2 >= self.window {

@@ -42,7 +42,7 @@ fn two_and_three_phases_are_found_at_their_boundaries() {
 fn context_window_tells_a_varying_phase_from_a_still_one() {
     // A "walk" alternates between two poses every 3 frames, a "stand" sits between them: on
     // single frames k = 2 splits the walk by pose; with a window it splits walk from stand.
-    let walk = |t: usize| if (t / 3) % 2 == 0 { vec![1.0, 0.0] } else { vec![-1.0, 0.0] };
+    let walk = |t: usize| if (t / 3).is_multiple_of(2) { vec![1.0, 0.0] } else { vec![-1.0, 0.0] };
     let mut frames: Vec<Vec<f64>> = (0..60).map(walk).collect();
     frames.extend((0..40).map(|_| vec![0.0, 0.0]));
     frames.extend((0..60).map(walk));

@@ -1,6 +1,5 @@
 //! Every `--help` ends with an EXAMPLES block of real pipelines; this runs each of them (in a
 //! scratch directory that sees the project's examples/) and requires success.
-use crate::common;
 
 use std::path::Path;
 use std::process::Command;

@@ -68,7 +68,7 @@ impl AnyTopStats {
 
     /// Check shapes and numbers (statistics come from files).
     pub fn check(&self, joints: usize) -> Result<(), AnyTopError> {
-        if self.mean.len() != self.std.len() || self.mean.len() % FEATURE_DIMS != 0 {
+        if self.mean.len() != self.std.len() || !self.mean.len().is_multiple_of(FEATURE_DIMS) {
             return Err(AnyTopError::BadStats("mean and std must both hold joints x 13 values".into()));
         }
         if self.joints() != joints {
