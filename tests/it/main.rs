@@ -23,6 +23,7 @@ mod mo_sample_edit;
 mod mo_segment_cli;
 mod mo_train_cli;
 mod mo_train_sample_cli;
+mod post_process;
 mod name_embeddings;
 mod npy;
 mod render_html;
