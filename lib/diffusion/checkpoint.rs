@@ -122,8 +122,9 @@ pub fn save(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &AdamW) -> 
     let tmp = |name: &str| dir.join(format!(".{name}.tmp"));
     let model = tmp("model.safetensors");
     varmap.save(&model).map_err(CheckpointError::tensor(format!("cannot write {}", model.display())))?;
-    let state: std::collections::HashMap<String, candle_core::Tensor> = opt.state().into_iter().collect();
     let optimizer = tmp("optimizer.safetensors");
+    let state: std::collections::HashMap<String, candle_core::Tensor> =
+        opt.state().map_err(CheckpointError::tensor(format!("cannot write {}", optimizer.display())))?.into_iter().collect();
     candle_core::safetensors::save(&state, &optimizer).map_err(CheckpointError::tensor(format!("cannot write {}", optimizer.display())))?;
     let text = serde_json::to_string_pretty(info).map_err(CheckpointError::json("serialising the checkpoint info".into()))?;
     let json = tmp("checkpoint.json");
@@ -241,7 +242,7 @@ pub fn load_optimizer(dir: &Path, step: u64, device: &Device, lr: f64) -> Result
     let path = dir.join("optimizer.safetensors");
     let tensors = candle_core::safetensors::load(&path, device).map_err(CheckpointError::tensor(format!("cannot load {}", path.display())))?;
     let mut opt = AdamW::new(lr);
-    opt.load_state(&tensors, step);
+    opt.load_state(&tensors, step).map_err(CheckpointError::tensor(format!("cannot load {}", path.display())))?;
     Ok(opt)
 }
 
