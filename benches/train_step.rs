@@ -5,7 +5,8 @@
 //! at each thread count in its own rayon pool. The thread counts take turns step by step
 //! (1, 2, 1, 2, ...) so that other work on the machine hits them alike, and each runs its own
 //! trainer from the same seed, so every thread count trains the same steps. Reports the median
-//! and spread of s/step, tokens/s (tokens = joints x (frames + P_S) of the batch's crops) and
+//! and spread of s/step, the median CPU seconds per step (all threads; less sensitive to other
+//! work on the machine than the wall clock), tokens/s (tokens = joints x (frames + P_S) of the batch's crops) and
 //! GFLOP/s of the model's matmul FLOPs (forward x 3 for forward + backward) next to the f32
 //! matmul peak, and whether the thread counts trained the same losses bit for bit.
 //!
@@ -31,6 +32,17 @@ use std::time::{Duration, Instant};
 
 fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
     std::env::var(name).ok().and_then(|s| s.trim().parse().ok()).unwrap_or(default)
+}
+
+/// CPU seconds (user + system) of the whole process so far.
+fn cpu_seconds() -> f64 {
+    // SAFETY: getrusage only writes the struct it is given.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
+        return f64::NAN;
+    }
+    let secs = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    secs(usage.ru_utime) + secs(usage.ru_stime)
 }
 
 fn matmul_peak() -> f64 {
@@ -120,6 +132,7 @@ fn main() {
 
     let warm = 2;
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); runs.len()];
+    let mut cpu: Vec<Vec<f64>> = vec![Vec::new(); runs.len()];
     let mut losses: Vec<Vec<u64>> = vec![Vec::new(); runs.len()];
     let (mut tokens, mut flops) = (0.0, 0.0);
     for k in 0..warm + steps {
@@ -129,27 +142,31 @@ fn main() {
             flops += f;
         }
         for (i, (_, pool, trainer, _)) in runs.iter_mut().enumerate() {
-            let t = Instant::now();
+            let (t, c) = (Instant::now(), cpu_seconds());
             let loss = pool.install(|| trainer.step(k)).expect("a training step");
-            let s = t.elapsed().as_secs_f64();
+            let (s, c) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
             losses[i].push(loss.total.to_bits());
             if k >= warm {
                 times[i].push(s);
+                cpu[i].push(c);
             }
         }
     }
     let (tokens, flops) = (tokens / steps as f64, flops / steps as f64);
     println!();
-    println!("| threads | median s/step | min-max | tokens/s | GFLOP/s | matmul peak GFLOP/s | of peak |");
-    println!("|---|---|---|---|---|---|---|");
+    println!("| threads | median s/step | min-max | CPU s/step | tokens/s | GFLOP/s | matmul peak GFLOP/s | of peak |");
+    println!("|---|---|---|---|---|---|---|---|");
     for (i, (n, _, _, peak)) in runs.iter().enumerate() {
         let mut t = times[i].clone();
         t.sort_by(f64::total_cmp);
         let med = t[t.len() / 2];
+        let mut c = cpu[i].clone();
+        c.sort_by(f64::total_cmp);
         println!(
-            "| {n} | {med:.3} | {:.3}-{:.3} | {:.0} | {:.1} | {peak:.1} | {:.0}% |",
+            "| {n} | {med:.3} | {:.3}-{:.3} | {:.3} | {:.0} | {:.1} | {peak:.1} | {:.0}% |",
             t[0],
             t[t.len() - 1],
+            c[c.len() / 2],
             tokens / med,
             flops / med / 1e9,
             100.0 * flops / med / 1e9 / peak

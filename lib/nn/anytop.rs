@@ -43,11 +43,13 @@ struct Context {
     temporal: Keys,
 }
 
-/// `[rows, 3d]` queries, keys and values from one matmul against the stacked weights.
-pub(crate) fn project_qkv(query: &Linear, key: &Linear, value: &Linear, rows: &Tensor) -> candle_core::Result<Tensor> {
+/// `[rows, 3d]` queries, keys and values from one matmul against the stacked weights; `x` is
+/// any shape with `d` last (its rows are all but the last dimension).
+pub(crate) fn project_qkv(query: &Linear, key: &Linear, value: &Linear, x: &Tensor) -> candle_core::Result<Tensor> {
     let w = Tensor::cat(&[query.weight(), key.weight(), value.weight()], 0)?; // [3d, d]
     let b = Tensor::cat(&[query.bias(), key.bias(), value.bias()], 0)?;
-    fused::add_broadcast(&rows.matmul(&w.t()?)?, &b, 1)
+    let d = x.dim(D::Minus1)?;
+    fused::linear(x, &w, &b, Some((x.elem_count() / d.max(1), w.dim(0)?).into()))
 }
 
 #[derive(Clone, Debug)]
@@ -75,12 +77,12 @@ impl SkeletalAttention {
     fn forward(&self, x: &Tensor, ctx: &Context, bias_projection: &Tensor) -> candle_core::Result<Tensor> {
         let (b, t, j) = (ctx.b, ctx.t, ctx.j);
         let d = x.dim(D::Minus1)?;
-        let qkv = project_qkv(&self.query, &self.key, &self.value, &x.reshape((b * t * j, d))?)?;
+        let qkv = project_qkv(&self.query, &self.key, &self.value, x)?;
         // c[row, h, type] = (q_i·Eq[type] + k_i·Ek[type]) / sqrt(dh): every topology term of
         // the logit (i, j) is c at the query's row for the pair's distance and relation type.
         let c = qkv.matmul(bias_projection)?;
         let y = fused::attention(&qkv, Some(&c), Groups::joints(b, t, j), self.heads, ctx.skeletal.clone())?;
-        self.out.forward(&y)?.reshape((b, t, j, d))
+        self.out.forward_shaped(&y, (b, t, j, d))
     }
 }
 
@@ -109,9 +111,9 @@ impl TemporalAttention {
     fn forward(&self, x: &Tensor, ctx: &Context) -> candle_core::Result<Tensor> {
         let (b, t, j) = (ctx.b, ctx.t, ctx.j);
         let d = x.dim(D::Minus1)?;
-        let qkv = project_qkv(&self.query, &self.key, &self.value, &x.reshape((b * t * j, d))?)?;
+        let qkv = project_qkv(&self.query, &self.key, &self.value, x)?;
         let y = fused::attention(&qkv, None, Groups::frames(b, t, j), self.heads, ctx.temporal.clone())?;
-        self.out.forward(&y)?.reshape((b, t, j, d))
+        self.out.forward_shaped(&y, (b, t, j, d))
     }
 }
 

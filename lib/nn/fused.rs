@@ -691,6 +691,149 @@ pub fn add_broadcast(x: &Tensor, v: &Tensor, groups: usize) -> Result<Tensor> {
     x.contiguous()?.apply_op2(&v.contiguous()?, op)
 }
 
+/// The parallelism candle's own CPU matmul uses (`Rayon(n)` for n = RAYON_NUM_THREADS or the
+/// CPU count), so our GEMMs split work as candle's do: a fixed number of parts, not the size
+/// of the rayon pool they happen to run in. The result is the same bytes either way.
+fn matmul_parallelism() -> gemm::Parallelism {
+    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    match *THREADS.get_or_init(candle_core::utils::get_num_threads) {
+        n if n > 1 => gemm::Parallelism::Rayon(n),
+        _ => gemm::Parallelism::None,
+    }
+}
+
+/// `d = a b` (`d += a b` when `accumulate`) for a contiguous row-major `d` (m x n) and views
+/// `a` (m x k) and `b` (k x n), with the gemm call candle's matmul makes.
+fn matmul_into(d: &mut [f32], a: &[f32], am: Strided, b: &[f32], bm: Strided, (m, n, k): (usize, usize, usize), accumulate: bool) -> Result<()> {
+    let dm = Strided { off: 0, rs: n, cs: 1 };
+    if d.len() != m * n || !am.fits(a.len(), m, k) || !bm.fits(b.len(), k, n) {
+        candle_core::bail!("fused linear: a {m} x {k} by {k} x {n} product does not fit its buffers");
+    }
+    if m == 0 || n == 0 {
+        return Ok(());
+    }
+    if k == 0 {
+        if !accumulate {
+            d.fill(0.0);
+        }
+        return Ok(());
+    }
+    // SAFETY: every element the three views address is inside its slice (checked above), and
+    // `d` is borrowed mutably, so it overlaps neither `a` nor `b`.
+    unsafe {
+        gemm::gemm(
+            m,
+            n,
+            k,
+            d.as_mut_ptr().add(dm.off),
+            dm.cs as isize,
+            dm.rs as isize,
+            accumulate,
+            a.as_ptr().add(am.off),
+            am.cs as isize,
+            am.rs as isize,
+            b.as_ptr().add(bm.off),
+            bm.cs as isize,
+            bm.rs as isize,
+            if accumulate { 1.0 } else { 0.0 },
+            1.0,
+            false,
+            false,
+            false,
+            matmul_parallelism(),
+        )
+    }
+    Ok(())
+}
+
+/// `y = x W^T + b` over the last dimension of `x` as one graph node. The forward is what
+/// `x.matmul(W.t())` plus the bias gives, to the bit (the same gemm call, then the bias added to
+/// each row); the backward gives `dx = dy W`, `dW = dy^T x` and `db` = the column sums of dy
+/// in one go. Built from candle's ops a linear was four nodes (reshape, transpose, matmul,
+/// bias add, reshape back), and candle's backward pass zero-fills and adds a fresh gradient
+/// buffer for every input of every node: that was a tenth of a training step (perf).
+#[derive(Clone, Debug)]
+struct LinearOp {
+    rows: usize,
+    inputs: usize,
+    outputs: usize,
+    shape: Shape,
+}
+
+impl CustomOp3 for LinearOp {
+    fn name(&self) -> &'static str {
+        "fused-linear"
+    }
+
+    fn cpu_fwd(&self, s1: &CpuStorage, l1: &Layout, s2: &CpuStorage, l2: &Layout, s3: &CpuStorage, l3: &Layout) -> Result<(CpuStorage, Shape)> {
+        let (x, w, b) = (f32_slice(s1, l1, "linear input")?, f32_slice(s2, l2, "linear weight")?, f32_slice(s3, l3, "linear bias")?);
+        let (rows, i, o) = (self.rows, self.inputs, self.outputs);
+        if x.len() != rows * i || w.len() != o * i || b.len() != o {
+            candle_core::bail!("fused linear: input of {} values, weight {}, bias {}, for {rows} rows of {i} -> {o}", x.len(), w.len(), b.len());
+        }
+        let mut y = vec![0f32; rows * o];
+        matmul_into(&mut y, x, Strided { off: 0, rs: i, cs: 1 }, w, Strided { off: 0, rs: 1, cs: i }, (rows, o, i), false)?;
+        for r in y.chunks_exact_mut(o.max(1)) {
+            r.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+        }
+        Ok((CpuStorage::F32(y), self.shape.clone()))
+    }
+
+    fn bwd(&self, x: &Tensor, w: &Tensor, b: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let (rows, i, o) = (self.rows, self.inputs, self.outputs);
+        let (dx, dw, db) = with_values(grad, "linear output gradient", |dy| {
+            if dy.len() != rows * o {
+                candle_core::bail!("fused linear: output gradient of {} values, expected {rows} x {o}", dy.len());
+            }
+            let dx = with_values(w, "linear weight", |wv| {
+                let mut dx = vec![0f32; rows * i];
+                matmul_into(&mut dx, dy, Strided { off: 0, rs: o, cs: 1 }, wv, Strided { off: 0, rs: i, cs: 1 }, (rows, i, o), false)?;
+                Ok(dx)
+            })?;
+            let dw = with_values(x, "linear input", |xv| {
+                let mut dw = vec![0f32; o * i];
+                matmul_into(&mut dw, dy, Strided { off: 0, rs: 1, cs: o }, xv, Strided { off: 0, rs: i, cs: 1 }, (o, i, rows), false)?;
+                Ok(dw)
+            })?;
+            let mut db = vec![0f32; o];
+            for r in dy.chunks_exact(o.max(1)) {
+                db.iter_mut().zip(r).for_each(|(a, b)| *a += b);
+            }
+            Ok((dx, dw, db))
+        })?;
+        Ok((
+            Some(Tensor::from_vec(dx, x.shape(), x.device())?),
+            Some(Tensor::from_vec(dw, w.shape(), w.device())?),
+            Some(Tensor::from_vec(db, b.shape(), b.device())?),
+        ))
+    }
+}
+
+/// `x W^T + b` over the last dimension of `x` (`weight`: `[outputs, inputs]`, `bias`:
+/// `[outputs]`), shaped `shape` (which must hold `rows x outputs` values; `None`: `x`'s shape
+/// with the last dimension `outputs`). One graph node; see `LinearOp`.
+pub fn linear(x: &Tensor, weight: &Tensor, bias: &Tensor, shape: Option<Shape>) -> Result<Tensor> {
+    let (outputs, inputs) = weight.dims2()?;
+    let dims = x.dims();
+    if dims.last() != Some(&inputs) || bias.elem_count() != outputs {
+        candle_core::bail!("fused linear: input {dims:?}, weight [{outputs}, {inputs}], bias of {}", bias.elem_count());
+    }
+    let rows = x.elem_count() / inputs.max(1);
+    let shape = match shape {
+        Some(s) if s.elem_count() == rows * outputs => s,
+        Some(s) => candle_core::bail!("fused linear: {rows} x {outputs} values do not make {s:?}"),
+        None => {
+            let mut d = dims.to_vec();
+            if let Some(last) = d.last_mut() {
+                *last = outputs;
+            }
+            Shape::from(d)
+        }
+    };
+    let op = LinearOp { rows, inputs, outputs, shape };
+    x.contiguous()?.apply_op3(&weight.contiguous()?, &bias.contiguous()?, op)
+}
+
 #[cfg(test)]
 #[path = "fused_tests.rs"]
 mod tests;

@@ -197,3 +197,45 @@ fn fast_exp_is_accurate_and_exactly_zero_for_masked_keys() {
     assert_eq!(super::exp(f32::NEG_INFINITY), 0.0);
     assert_eq!(super::exp(-1e9), 0.0);
 }
+
+#[test]
+fn linear_matches_basic_ops() {
+    let dev = Device::Cpu;
+    let mut rng = SplitMix64::new(8);
+    for (dims, inputs, outputs) in [(vec![2, 3, 5], 5, 7), (vec![70, 16], 16, 48), (vec![1, 4], 4, 1)] {
+        let n: usize = dims.iter().product();
+        let x = Var::from_vec(random(&mut rng, n), dims.as_slice(), &dev).unwrap();
+        let w = Var::from_vec(random(&mut rng, outputs * inputs), (outputs, inputs), &dev).unwrap();
+        let b = Var::from_vec(random(&mut rng, outputs), outputs, &dev).unwrap();
+        let fused = linear(x.as_tensor(), w.as_tensor(), b.as_tensor(), None).unwrap();
+        let rows = n / inputs;
+        let mut out_dims = dims.clone();
+        *out_dims.last_mut().unwrap() = outputs;
+        let reference = x
+            .as_tensor()
+            .reshape((rows, inputs))
+            .unwrap()
+            .matmul(&w.as_tensor().t().unwrap())
+            .unwrap()
+            .broadcast_add(b.as_tensor())
+            .unwrap()
+            .reshape(out_dims.as_slice())
+            .unwrap();
+        assert_eq!(fused.dims(), out_dims.as_slice());
+        assert_eq!(values(&fused).unwrap(), values(&reference).unwrap(), "the forward is candle's matmul and bias add, to the bit");
+        let gf = weighted_sum(&fused, 4).backward().unwrap();
+        let gr = weighted_sum(&reference, 4).backward().unwrap();
+        for (name, var) in [("x", &x), ("weight", &w), ("bias", &b)] {
+            let (a, r) = (gf.get(var.as_tensor()).unwrap(), gr.get(var.as_tensor()).unwrap());
+            assert!(max_diff(a, r) < 1e-5, "{name} gradient differs by {}", max_diff(a, r));
+        }
+        // Another shape for the same values.
+        let flat = linear(x.as_tensor(), w.as_tensor(), b.as_tensor(), Some((rows * outputs,).into())).unwrap();
+        assert_eq!(values(&flat).unwrap(), values(&fused).unwrap());
+    }
+    let x = Tensor::zeros((3, 4), candle_core::DType::F32, &dev).unwrap();
+    let w = Tensor::zeros((2, 5), candle_core::DType::F32, &dev).unwrap();
+    assert!(linear(&x, &w, &Tensor::zeros(2, candle_core::DType::F32, &dev).unwrap(), None).is_err(), "4 inputs against a weight for 5");
+    let w = Tensor::zeros((2, 4), candle_core::DType::F32, &dev).unwrap();
+    assert!(linear(&x, &w, &Tensor::zeros(2, candle_core::DType::F32, &dev).unwrap(), Some((7,).into())).is_err(), "6 values do not make 7");
+}
