@@ -834,6 +834,170 @@ pub fn linear(x: &Tensor, weight: &Tensor, bias: &Tensor, shape: Option<Shape>) 
     x.contiguous()?.apply_op3(&weight.contiguous()?, &bias.contiguous()?, op)
 }
 
+/// `d = beta a b` (`d += beta a b` when `accumulate`) for views `d` (m x n), `a` (m x k) and
+/// `b` (k x n), with the parallelism of candle's matmul; an error, not a panic, when a view
+/// overruns its buffer.
+#[allow(clippy::too_many_arguments)]
+fn strided_gemm(
+    d: &mut [f32],
+    dm: Strided,
+    a: &[f32],
+    am: Strided,
+    b: &[f32],
+    bm: Strided,
+    (m, n, k): (usize, usize, usize),
+    beta: f32,
+    accumulate: bool,
+) -> Result<()> {
+    if !dm.fits(d.len(), m, n) || !am.fits(a.len(), m, k) || !bm.fits(b.len(), k, n) {
+        candle_core::bail!("fused kernel: a {m} x {k} by {k} x {n} product does not fit its buffers");
+    }
+    if m == 0 || n == 0 || k == 0 {
+        if !accumulate && k == 0 {
+            candle_core::bail!("fused kernel: empty inner dimension");
+        }
+        return Ok(());
+    }
+    // SAFETY: every element the three views address is inside its slice (checked above), and
+    // `d` is borrowed mutably, so it overlaps neither `a` nor `b`.
+    unsafe {
+        gemm::gemm(
+            m,
+            n,
+            k,
+            d.as_mut_ptr().add(dm.off),
+            dm.cs as isize,
+            dm.rs as isize,
+            accumulate,
+            a.as_ptr().add(am.off),
+            am.cs as isize,
+            am.rs as isize,
+            b.as_ptr().add(bm.off),
+            bm.cs as isize,
+            bm.rs as isize,
+            1.0,
+            beta,
+            false,
+            false,
+            false,
+            matmul_parallelism(),
+        )
+    }
+    Ok(())
+}
+
+/// The skeletal attention's topology coefficients (see `anytop`): for every token row, head h
+/// and type t, `c[row, h, t] = (q_h . Eq[t]_h + k_h . Ek[t]_h) / sqrt(head_dim)`, where `_h` is
+/// head h's slice of the width. As one `[3d, H * types]` matrix product this was mostly zeros
+/// (the value rows, and the other heads' rows of each column): six times the multiply-adds
+/// needed. Here it is two GEMMs per head over that head's slice only, and the same in the
+/// backward pass.
+#[derive(Clone, Copy, Debug)]
+struct TopologyCoefficients {
+    rows: usize,
+    heads: usize,
+    head_dim: usize,
+    types: usize,
+    scale: f32,
+}
+
+impl TopologyCoefficients {
+    fn width(&self) -> usize {
+        self.heads * self.head_dim
+    }
+
+    fn check(&self, qkv: usize, eq: usize, ek: usize) -> Result<()> {
+        let w = self.width();
+        if qkv != self.rows * 3 * w || eq != self.types * w || ek != self.types * w {
+            candle_core::bail!(
+                "topology coefficients: q/k/v of {qkv} values, tables of {eq} and {ek}, for {} rows of width {w} and {} types",
+                self.rows,
+                self.types
+            );
+        }
+        Ok(())
+    }
+
+    /// Head h's queries (`part` 0) or keys (1): `rows x head_dim` inside the q/k/v matrix.
+    fn tokens(&self, part: usize, h: usize) -> Strided {
+        Strided { off: part * self.width() + h * self.head_dim, rs: 3 * self.width(), cs: 1 }
+    }
+
+    /// Head h's slice of a `[types, d]` table: `types x head_dim`.
+    fn table(&self, h: usize) -> Strided {
+        Strided { off: h * self.head_dim, rs: self.width(), cs: 1 }
+    }
+
+    /// Head h's coefficients: `rows x types` inside `[rows, heads * types]`.
+    fn coefficients(&self, h: usize) -> Strided {
+        Strided { off: h * self.types, rs: self.heads * self.types, cs: 1 }
+    }
+}
+
+impl CustomOp3 for TopologyCoefficients {
+    fn name(&self) -> &'static str {
+        "fused-topology-coefficients"
+    }
+
+    fn cpu_fwd(&self, s1: &CpuStorage, l1: &Layout, s2: &CpuStorage, l2: &Layout, s3: &CpuStorage, l3: &Layout) -> Result<(CpuStorage, Shape)> {
+        let (qkv, eq, ek) = (f32_slice(s1, l1, "q/k/v")?, f32_slice(s2, l2, "query table")?, f32_slice(s3, l3, "key table")?);
+        self.check(qkv.len(), eq.len(), ek.len())?;
+        let (rows, dh, ty) = (self.rows, self.head_dim, self.types);
+        let mut c = vec![0f32; rows * self.heads * ty];
+        for h in 0..self.heads {
+            strided_gemm(&mut c, self.coefficients(h), qkv, self.tokens(0, h), eq, self.table(h).t(), (rows, ty, dh), self.scale, false)?;
+            strided_gemm(&mut c, self.coefficients(h), qkv, self.tokens(1, h), ek, self.table(h).t(), (rows, ty, dh), self.scale, true)?;
+        }
+        Ok((CpuStorage::F32(c), Shape::from((rows, self.heads * ty))))
+    }
+
+    fn bwd(&self, qkv: &Tensor, eq: &Tensor, ek: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let (rows, dh, ty) = (self.rows, self.head_dim, self.types);
+        let (dqkv, deq, dek) = with_values(grad, "topology coefficient gradient", |dc| {
+            with_values(qkv, "q/k/v", |qv| {
+                with_values(eq, "query table", |eqv| {
+                    with_values(ek, "key table", |ekv| {
+                        self.check(qv.len(), eqv.len(), ekv.len())?;
+                        if dc.len() != rows * self.heads * ty {
+                            candle_core::bail!("topology coefficients: gradient of {} values, expected {rows} x {}", dc.len(), self.heads * ty);
+                        }
+                        let mut dqkv = vec![0f32; qv.len()];
+                        let (mut deq, mut dek) = (vec![0f32; eqv.len()], vec![0f32; ekv.len()]);
+                        for h in 0..self.heads {
+                            let dch = self.coefficients(h);
+                            for (part, table, dtable) in [(0, eqv, &mut deq), (1, ekv, &mut dek)] {
+                                // d tokens = scale dC E_h;  d E_h = scale dC^T tokens.
+                                strided_gemm(&mut dqkv, self.tokens(part, h), dc, dch, table, self.table(h), (rows, dh, ty), self.scale, false)?;
+                                strided_gemm(dtable, self.table(h), dc, dch.t(), qv, self.tokens(part, h), (ty, dh, rows), self.scale, false)?;
+                            }
+                        }
+                        Ok((dqkv, deq, dek))
+                    })
+                })
+            })
+        })?;
+        Ok((
+            Some(Tensor::from_vec(dqkv, qkv.shape(), qkv.device())?),
+            Some(Tensor::from_vec(deq, eq.shape(), eq.device())?),
+            Some(Tensor::from_vec(dek, ek.shape(), ek.device())?),
+        ))
+    }
+}
+
+/// The skeletal attention's topology coefficients `[rows, heads * types]` from the q/k/v
+/// matrix `[rows, 3d]` and the query and key tables `[types, d]`, scaled by
+/// `1/sqrt(head_dim)`: see `TopologyCoefficients`.
+pub fn topology_coefficients(qkv: &Tensor, query_table: &Tensor, key_table: &Tensor, heads: usize) -> Result<Tensor> {
+    let (rows, w3) = qkv.dims2()?;
+    let (types, w) = query_table.dims2()?;
+    if heads == 0 || w % heads != 0 || w3 != 3 * w || key_table.dims() != query_table.dims() {
+        candle_core::bail!("topology coefficients: q/k/v {rows} x {w3}, tables {:?} and {:?}, {heads} heads", query_table.dims(), key_table.dims());
+    }
+    let head_dim = w / heads;
+    let op = TopologyCoefficients { rows, heads, head_dim, types, scale: 1.0 / (head_dim as f32).sqrt() };
+    qkv.contiguous()?.apply_op3(&query_table.contiguous()?, &key_table.contiguous()?, op)
+}
+
 #[cfg(test)]
 #[path = "fused_tests.rs"]
 mod tests;

@@ -239,3 +239,38 @@ fn linear_matches_basic_ops() {
     let w = Tensor::zeros((2, 4), candle_core::DType::F32, &dev).unwrap();
     assert!(linear(&x, &w, &Tensor::zeros(2, candle_core::DType::F32, &dev).unwrap(), Some((7,).into())).is_err(), "6 values do not make 7");
 }
+
+#[test]
+fn topology_coefficients_match_the_projection_matrix() {
+    let dev = Device::Cpu;
+    let (rows, heads, dh, types) = (13, 3, 4, 5);
+    let w = heads * dh;
+    let mut rng = SplitMix64::new(10);
+    let qkv = Var::from_vec(random(&mut rng, rows * 3 * w), (rows, 3 * w), &dev).unwrap();
+    let eq = Var::from_vec(random(&mut rng, types * w), (types, w), &dev).unwrap();
+    let ek = Var::from_vec(random(&mut rng, types * w), (types, w), &dev).unwrap();
+    let fused = topology_coefficients(qkv.as_tensor(), eq.as_tensor(), ek.as_tensor(), heads).unwrap();
+    // How the model computed it before: one [3w, heads * types] matrix, each head's block on
+    // its own rows, the value rows zero.
+    let mut block = vec![0f32; w * heads * types];
+    for row in 0..w {
+        for ty in 0..types {
+            block[row * heads * types + (row / dh) * types + ty] = 1.0;
+        }
+    }
+    let block = Tensor::from_vec(block, (w, heads * types), &dev).unwrap();
+    let per_head = |t: &Tensor| t.t().unwrap().repeat((1, heads)).unwrap().mul(&block).unwrap();
+    let projection =
+        Tensor::cat(&[per_head(eq.as_tensor()), per_head(ek.as_tensor()), Tensor::zeros((w, heads * types), candle_core::DType::F32, &dev).unwrap()], 0)
+            .unwrap();
+    let reference = (qkv.as_tensor().matmul(&projection).unwrap() * (1.0 / (dh as f64).sqrt())).unwrap();
+    assert_eq!(fused.dims(), &[rows, heads * types]);
+    assert!(max_diff(&fused, &reference) < 1e-5, "forward differs by {}", max_diff(&fused, &reference));
+    let gf = weighted_sum(&fused, 11).backward().unwrap();
+    let gr = weighted_sum(&reference, 11).backward().unwrap();
+    for (name, var) in [("q/k/v", &qkv), ("query table", &eq), ("key table", &ek)] {
+        let (a, r) = (gf.get(var.as_tensor()).unwrap(), gr.get(var.as_tensor()).unwrap());
+        assert!(max_diff(a, r) < 1e-5, "{name} gradient differs by {}", max_diff(a, r));
+    }
+    assert!(topology_coefficients(qkv.as_tensor(), eq.as_tensor(), ek.as_tensor(), 5).is_err(), "12 is no multiple of 5 heads");
+}
