@@ -563,14 +563,105 @@ struct LayerNormOp {
 }
 
 impl LayerNormOp {
-    /// Per row: the normalised values (into `xhat`) and 1/sigma.
+    /// Per row: the normalised values (into `xhat`) and 1/sigma. Sums with eight partial sums
+    /// (see `sum`), and plain index loops: this is inlined into `target_feature` functions, where
+    /// a closure would be compiled without the feature.
+    #[inline(always)]
     fn normalise(&self, x: &[f32], xhat: &mut [f32]) -> f32 {
         let n = x.len() as f32;
-        let mean = x.iter().sum::<f32>() / n;
-        let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f32>() / n;
+        let mean = sum(x) / n;
+        for e in 0..x.len() {
+            xhat[e] = x[e] - mean;
+        }
+        let var = dot(xhat, xhat) / n;
         let rstd = 1.0 / (var + self.eps).sqrt();
-        xhat.iter_mut().zip(x).for_each(|(o, v)| *o = (v - mean) * rstd);
+        for v in xhat.iter_mut() {
+            *v *= rstd;
+        }
         rstd
+    }
+
+    #[inline(always)]
+    fn forward_body(&self, x: &[f32], w: &[f32], b: &[f32]) -> Vec<f32> {
+        let d = w.len();
+        let mut y = vec![0f32; x.len()];
+        for (xr, yr) in x.chunks_exact(d).zip(y.chunks_exact_mut(d)) {
+            self.normalise(xr, yr);
+            for e in 0..d {
+                yr[e] = yr[e] * w[e] + b[e];
+            }
+        }
+        y
+    }
+
+    /// The same loops compiled for 8-wide vectors.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn forward_avx2(&self, x: &[f32], w: &[f32], b: &[f32]) -> Vec<f32> {
+        self.forward_body(x, w, b)
+    }
+
+    fn forward(&self, x: &[f32], w: &[f32], b: &[f32]) -> Vec<f32> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, the only feature `forward_avx2` is compiled for.
+            return unsafe { self.forward_avx2(x, w, b) };
+        }
+        self.forward_body(x, w, b)
+    }
+
+    /// `(dx, dw, db)` from the input, weight and output gradient.
+    #[inline(always)]
+    fn backward_body(&self, xv: &[f32], wv: &[f32], dy: &[f32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        let d = wv.len();
+        let n = d as f32;
+        let mut dx = vec![0f32; xv.len()];
+        let (mut dw, mut db) = (vec![0f32; d], vec![0f32; d]);
+        let mut xhat = vec![0f32; d];
+        let mut g = vec![0f32; d];
+        for ((xr, dyr), dxr) in xv.chunks_exact(d).zip(dy.chunks_exact(d)).zip(dx.chunks_exact_mut(d)) {
+            let rstd = self.normalise(xr, &mut xhat);
+            for e in 0..d {
+                dw[e] += dyr[e] * xhat[e];
+                db[e] += dyr[e];
+                g[e] = dyr[e] * wv[e];
+            }
+            // dx = rstd (g - mean(g) - xhat mean(g xhat))
+            let mean_g = sum(&g) / n;
+            let mean_gx = dot(&g, &xhat) / n;
+            for e in 0..d {
+                dxr[e] = rstd * (g[e] - mean_g - xhat[e] * mean_gx);
+            }
+        }
+        (dx, dw, db)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn backward_avx2(&self, xv: &[f32], wv: &[f32], dy: &[f32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        self.backward_body(xv, wv, dy)
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn backward(&self, x: &Tensor, w: &Tensor, b: &Tensor, xv: &[f32], wv: &[f32], dy: &[f32]) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let d = wv.len();
+        if d == 0 || xv.len() % d != 0 || dy.len() != xv.len() {
+            candle_core::bail!("layer norm backward: input of {} values, weight {d}, output gradient {}", xv.len(), dy.len());
+        }
+        #[cfg(target_arch = "x86_64")]
+        let (dx, dw, db) = if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, the only feature `backward_avx2` is compiled for.
+            unsafe { self.backward_avx2(xv, wv, dy) }
+        } else {
+            self.backward_body(xv, wv, dy)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let (dx, dw, db) = self.backward_body(xv, wv, dy);
+        Ok((
+            Some(Tensor::from_vec(dx, x.shape(), x.device())?),
+            Some(Tensor::from_vec(dw, w.shape(), w.device())?),
+            Some(Tensor::from_vec(db, b.shape(), b.device())?),
+        ))
     }
 }
 
@@ -585,49 +676,13 @@ impl CustomOp3 for LayerNormOp {
         if d == 0 || b.len() != d || x.len() % d != 0 {
             candle_core::bail!("layer norm: input of {} values, weight {d}, bias {}", x.len(), b.len());
         }
-        let mut y = vec![0f32; x.len()];
-        for (xr, yr) in x.chunks_exact(d).zip(y.chunks_exact_mut(d)) {
-            self.normalise(xr, yr);
-            yr.iter_mut().zip(w.iter().zip(b)).for_each(|(v, (w, b))| *v = *v * w + b);
-        }
-        Ok((CpuStorage::F32(y), l1.shape().clone()))
+        Ok((CpuStorage::F32(self.forward(x, w, b)), l1.shape().clone()))
     }
 
     fn bwd(&self, x: &Tensor, w: &Tensor, b: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
         with_values(x, "layer norm input", |xv| {
             with_values(w, "layer norm weight", |wv| with_values(grad, "layer norm output gradient", |dy| self.backward(x, w, b, xv, wv, dy)))
         })
-    }
-}
-
-impl LayerNormOp {
-    #[allow(clippy::type_complexity)]
-    fn backward(&self, x: &Tensor, w: &Tensor, b: &Tensor, xv: &[f32], wv: &[f32], dy: &[f32]) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        let d = wv.len();
-        let mut dx = vec![0f32; xv.len()];
-        let (mut dw, mut db) = (vec![0f32; d], vec![0f32; d]);
-        let mut xhat = vec![0f32; d];
-        let mut g = vec![0f32; d];
-        for ((xr, dyr), dxr) in xv.chunks_exact(d).zip(dy.chunks_exact(d)).zip(dx.chunks_exact_mut(d)) {
-            let rstd = self.normalise(xr, &mut xhat);
-            for e in 0..d {
-                dw[e] += dyr[e] * xhat[e];
-                db[e] += dyr[e];
-                g[e] = dyr[e] * wv[e];
-            }
-            // dx = rstd (g - mean(g) - xhat mean(g xhat))
-            let n = d as f32;
-            let mean_g = g.iter().sum::<f32>() / n;
-            let mean_gx = g.iter().zip(&xhat).map(|(a, b)| a * b).sum::<f32>() / n;
-            for e in 0..d {
-                dxr[e] = rstd * (g[e] - mean_g - xhat[e] * mean_gx);
-            }
-        }
-        Ok((
-            Some(Tensor::from_vec(dx, x.shape(), x.device())?),
-            Some(Tensor::from_vec(dw, w.shape(), w.device())?),
-            Some(Tensor::from_vec(db, b.shape(), b.device())?),
-        ))
     }
 }
 
@@ -702,48 +757,47 @@ fn matmul_parallelism() -> gemm::Parallelism {
     }
 }
 
-/// `d = a b` (`d += a b` when `accumulate`) for a contiguous row-major `d` (m x n) and views
-/// `a` (m x k) and `b` (k x n), with the gemm call candle's matmul makes.
-fn matmul_into(d: &mut [f32], a: &[f32], am: Strided, b: &[f32], bm: Strided, (m, n, k): (usize, usize, usize), accumulate: bool) -> Result<()> {
-    let dm = Strided { off: 0, rs: n, cs: 1 };
-    if d.len() != m * n || !am.fits(a.len(), m, k) || !bm.fits(b.len(), k, n) {
-        candle_core::bail!("fused linear: a {m} x {k} by {k} x {n} product does not fit its buffers");
+/// `a b` as a new contiguous row-major `m x n` buffer, for views `a` (m x k) and `b` (k x n),
+/// with the gemm call candle's matmul makes (so the same bytes as `matmul`).
+fn matmul_new(a: &[f32], am: Strided, b: &[f32], bm: Strided, (m, n, k): (usize, usize, usize)) -> Result<Vec<f32>> {
+    if !am.fits(a.len(), m, k) || !bm.fits(b.len(), k, n) {
+        candle_core::bail!("fused kernel: a {m} x {k} by {k} x {n} product does not fit its buffers");
     }
-    if m == 0 || n == 0 {
-        return Ok(());
+    let len = m.checked_mul(n).ok_or_else(|| candle_core::Error::Msg(format!("fused kernel: a {m} x {n} product is too large")))?;
+    if len == 0 || k == 0 {
+        return Ok(vec![0f32; len]);
     }
-    if k == 0 {
-        if !accumulate {
-            d.fill(0.0);
-        }
-        return Ok(());
-    }
-    // SAFETY: every element the three views address is inside its slice (checked above), and
-    // `d` is borrowed mutably, so it overlaps neither `a` nor `b`.
+    let mut d: Vec<f32> = Vec::with_capacity(len);
+    // SAFETY: the views fit their slices (checked above) and `d` has room for the m x n
+    // destination, a fresh allocation that overlaps neither. With `read_dst` false gemm
+    // (0.19, `gemm_basic_generic`) sets alpha to zero and writes every destination element
+    // without reading it, so no zero fill is needed (it was 1-2% of a training step), and
+    // after the call all `len` values are initialised.
     unsafe {
         gemm::gemm(
             m,
             n,
             k,
-            d.as_mut_ptr().add(dm.off),
-            dm.cs as isize,
-            dm.rs as isize,
-            accumulate,
+            d.as_mut_ptr(),
+            1,
+            n as isize,
+            false,
             a.as_ptr().add(am.off),
             am.cs as isize,
             am.rs as isize,
             b.as_ptr().add(bm.off),
             bm.cs as isize,
             bm.rs as isize,
-            if accumulate { 1.0 } else { 0.0 },
+            0.0,
             1.0,
             false,
             false,
             false,
             matmul_parallelism(),
-        )
+        );
+        d.set_len(len);
     }
-    Ok(())
+    Ok(d)
 }
 
 /// `y = x W^T + b` over the last dimension of `x` as one graph node. The forward is what
@@ -771,8 +825,7 @@ impl CustomOp3 for LinearOp {
         if x.len() != rows * i || w.len() != o * i || b.len() != o {
             candle_core::bail!("fused linear: input of {} values, weight {}, bias {}, for {rows} rows of {i} -> {o}", x.len(), w.len(), b.len());
         }
-        let mut y = vec![0f32; rows * o];
-        matmul_into(&mut y, x, Strided { off: 0, rs: i, cs: 1 }, w, Strided { off: 0, rs: 1, cs: i }, (rows, o, i), false)?;
+        let mut y = matmul_new(x, Strided { off: 0, rs: i, cs: 1 }, w, Strided { off: 0, rs: 1, cs: i }, (rows, o, i))?;
         for r in y.chunks_exact_mut(o.max(1)) {
             r.iter_mut().zip(b).for_each(|(a, b)| *a += b);
         }
@@ -785,16 +838,9 @@ impl CustomOp3 for LinearOp {
             if dy.len() != rows * o {
                 candle_core::bail!("fused linear: output gradient of {} values, expected {rows} x {o}", dy.len());
             }
-            let dx = with_values(w, "linear weight", |wv| {
-                let mut dx = vec![0f32; rows * i];
-                matmul_into(&mut dx, dy, Strided { off: 0, rs: o, cs: 1 }, wv, Strided { off: 0, rs: i, cs: 1 }, (rows, i, o), false)?;
-                Ok(dx)
-            })?;
-            let dw = with_values(x, "linear input", |xv| {
-                let mut dw = vec![0f32; o * i];
-                matmul_into(&mut dw, dy, Strided { off: 0, rs: 1, cs: o }, xv, Strided { off: 0, rs: i, cs: 1 }, (o, i, rows), false)?;
-                Ok(dw)
-            })?;
+            let dx =
+                with_values(w, "linear weight", |wv| matmul_new(dy, Strided { off: 0, rs: o, cs: 1 }, wv, Strided { off: 0, rs: i, cs: 1 }, (rows, i, o)))?;
+            let dw = with_values(x, "linear input", |xv| matmul_new(dy, Strided { off: 0, rs: 1, cs: o }, xv, Strided { off: 0, rs: i, cs: 1 }, (o, i, rows)))?;
             let mut db = vec![0f32; o];
             for r in dy.chunks_exact(o.max(1)) {
                 db.iter_mut().zip(r).for_each(|(a, b)| *a += b);

@@ -133,18 +133,25 @@ fn temporal_attention_case(t: usize, half: usize) {
 
 #[test]
 fn layer_norm_matches_basic_ops() {
+    // 8: whole vectors of eight; 13: a remainder (the sums run in eight lanes).
+    for width in [8, 13] {
+        layer_norm_case(width);
+    }
+}
+
+fn layer_norm_case(width: usize) {
     let dev = Device::Cpu;
     let mut rng = SplitMix64::new(5);
-    let x = Var::from_vec(random(&mut rng, 6 * 8), (2, 3, 8), &dev).unwrap();
-    let wt = Var::from_vec(random(&mut rng, 8), 8, &dev).unwrap();
-    let bs = Var::from_vec(random(&mut rng, 8), 8, &dev).unwrap();
+    let x = Var::from_vec(random(&mut rng, 6 * width), (2, 3, width), &dev).unwrap();
+    let wt = Var::from_vec(random(&mut rng, width), width, &dev).unwrap();
+    let bs = Var::from_vec(random(&mut rng, width), width, &dev).unwrap();
     let fused = layer_norm(x.as_tensor(), wt.as_tensor(), bs.as_tensor(), 1e-5).unwrap();
     let xt = x.as_tensor();
     let centred = xt.broadcast_sub(&xt.mean_keepdim(D::Minus1).unwrap()).unwrap();
     let var = centred.sqr().unwrap().mean_keepdim(D::Minus1).unwrap();
     let reference =
         centred.broadcast_div(&(var + 1e-5).unwrap().sqrt().unwrap()).unwrap().broadcast_mul(wt.as_tensor()).unwrap().broadcast_add(bs.as_tensor()).unwrap();
-    assert_eq!(fused.dims(), &[2, 3, 8]);
+    assert_eq!(fused.dims(), &[2, 3, width]);
     assert!(max_diff(&fused, &reference) < 1e-5);
     let gf = weighted_sum(&fused, 1).backward().unwrap();
     let gr = weighted_sum(&reference, 1).backward().unwrap();
