@@ -16,7 +16,7 @@
 //! NN_BENCH_GLIBC_DEFAULTS is set. Current numbers: BENCHMARKS.md.
 
 mod common;
-use common::{median, ms, time_runs};
+use common::{denoiser_forward_flops, median, ms, time_runs};
 
 use candle_core::{DType, Device, Tensor};
 use candle_nn::VarMap;
@@ -68,20 +68,6 @@ fn clip(joints: usize, frames: usize, name_dim: usize, rng: &mut SplitMix64) -> 
         distances: topology::distances(&skeleton, topology::DEFAULT_DMAX),
         names: (0..joints).map(|_| (0..name_dim).map(|_| rng.range(-0.1, 0.1) as f32).collect()).collect(),
     }
-}
-
-/// Matmul FLOPs of one forward pass (multiply-adds x 2), for tokens `b x t x j`.
-fn forward_flops(cfg: &DenoiserConfig, b: usize, t: usize, j: usize) -> f64 {
-    let (d, h) = (cfg.width as f64, cfg.heads as f64);
-    let (b, t, j) = (b as f64, t as f64, j as f64);
-    let n = b * t * j;
-    let types = (cfg.dmax + 1 + 6) as f64;
-    let input = 2.0 * n * (cfg.feature_dims as f64 + cfg.name_dim as f64 / t) * d;
-    let linears = 2.0 * n * d * d * 8.0 + 2.0 * n * d * cfg.ff as f64 * 2.0;
-    let skeletal = 2.0 * b * t * j * j * d * 2.0 + 2.0 * n * d * types * 2.0 + 2.0 * b * j * t * h * types * j;
-    let temporal = 2.0 * b * j * t * t * d * 2.0;
-    let output = 2.0 * n * d * cfg.feature_dims as f64;
-    input + cfg.layers as f64 * (linears + skeletal + temporal) + output
 }
 
 fn main() {
@@ -144,7 +130,7 @@ fn main() {
         let vm = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&vm, 0, &dev), &cfg).unwrap();
         let (_, t, j, _) = batch.dims().unwrap();
-        let flops = forward_flops(&cfg, b, t, j);
+        let flops = denoiser_forward_flops(&cfg, b, t, j);
         // One warm-up, then fewer runs when a step takes seconds.
         let warm = Instant::now();
         black_box(model.forward(&batch).unwrap());

@@ -49,3 +49,17 @@ pub fn bvh_files(dir: &Path) -> Vec<PathBuf> {
     out.sort();
     out
 }
+
+/// Matmul FLOPs of one forward pass (multiply-adds x 2), for tokens `b x t x j`.
+pub fn denoiser_forward_flops(cfg: &menagerie::nn::DenoiserConfig, b: usize, t: usize, j: usize) -> f64 {
+    let (d, h) = (cfg.width as f64, cfg.heads as f64);
+    let (b, t, j) = (b as f64, t as f64, j as f64);
+    let n = b * t * j;
+    let types = (cfg.dmax + 1 + 6) as f64;
+    let input = 2.0 * n * (cfg.feature_dims as f64 + cfg.name_dim as f64 / t) * d;
+    let linears = 2.0 * n * d * d * 8.0 + 2.0 * n * d * cfg.ff as f64 * 2.0;
+    let skeletal = 2.0 * b * t * j * j * d * 2.0 + 2.0 * n * d * types * 2.0 + 2.0 * b * j * t * h * types * j;
+    let temporal = 2.0 * b * j * t * t * d * 2.0;
+    let output = 2.0 * n * d * cfg.feature_dims as f64;
+    input + cfg.layers as f64 * (linears + skeletal + temporal) + output
+}

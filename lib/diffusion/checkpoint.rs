@@ -132,7 +132,9 @@ pub fn save_averaged(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &A
     std::fs::create_dir_all(dir).map_err(CheckpointError::io(format!("cannot create {}", dir.display())))?;
     let tmp = |name: &str| dir.join(format!(".{name}.tmp"));
     let model = tmp("model.safetensors");
-    let mut state: std::collections::HashMap<String, candle_core::Tensor> = opt.state().into_iter().collect();
+    let optimizer = tmp("optimizer.safetensors");
+    let mut state: std::collections::HashMap<String, candle_core::Tensor> =
+        opt.state().map_err(CheckpointError::tensor(format!("cannot write {}", optimizer.display())))?.into_iter().collect();
     match ema {
         None => varmap.save(&model).map_err(CheckpointError::tensor(format!("cannot write {}", model.display())))?,
         Some(ema) => {
@@ -143,7 +145,6 @@ pub fn save_averaged(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &A
             }
         }
     }
-    let optimizer = tmp("optimizer.safetensors");
     candle_core::safetensors::save(&state, &optimizer).map_err(CheckpointError::tensor(format!("cannot write {}", optimizer.display())))?;
     let text = serde_json::to_string_pretty(info).map_err(CheckpointError::json("serialising the checkpoint info".into()))?;
     let json = tmp("checkpoint.json");
@@ -269,7 +270,7 @@ pub fn load_optimizer(dir: &Path, step: u64, device: &Device, lr: f64) -> Result
     let path = dir.join("optimizer.safetensors");
     let tensors = candle_core::safetensors::load(&path, device).map_err(CheckpointError::tensor(format!("cannot load {}", path.display())))?;
     let mut opt = AdamW::new(lr);
-    opt.load_state(&tensors, step);
+    opt.load_state(&tensors, step).map_err(CheckpointError::tensor(format!("cannot load {}", path.display())))?;
     Ok(opt)
 }
 

@@ -12,6 +12,7 @@ use super::data::{Crop, TrainSet};
 use super::schedule::Schedule;
 use crate::nn::{batch_from, BatchItem, Denoiser, NnError};
 use crate::rng::{gaussian, SplitMix64};
+use candle_core::backprop::GradStore;
 use candle_core::cpu_backend::unary_map;
 use candle_core::{CpuStorage, CustomOp1, DType, Device, Layout, Shape, Tensor, Var};
 use candle_nn::VarMap;
@@ -25,8 +26,15 @@ pub struct AdamW {
     pub eps: f64,
     pub weight_decay: f64,
     pub step: u64,
-    /// (first moment, second moment) per parameter.
-    moments: BTreeMap<String, (Tensor, Tensor)>,
+    /// First and second moment estimates per parameter.
+    moments: BTreeMap<String, Moments>,
+}
+
+/// The moment estimates of one parameter, as flat f32 values in the parameter's layout.
+struct Moments {
+    m: Vec<f32>,
+    v: Vec<f32>,
+    shape: Shape,
 }
 
 impl AdamW {
@@ -38,52 +46,147 @@ impl AdamW {
     /// One update of every variable of `vars` from `grads`; variables without a gradient are
     /// left alone.
     pub fn update(&mut self, vars: &BTreeMap<String, Var>, grads: &candle_core::backprop::GradStore) -> candle_core::Result<()> {
+        self.update_sum(vars, std::slice::from_ref(grads))
+    }
+
+    /// One update from the sum of several gradients (a batch's groups, each with its own
+    /// backward pass): a variable's gradient is `parts[0] + parts[1] + ...` in that order, so
+    /// the update does not depend on which thread computed which part. Variables no part has
+    /// a gradient for are left alone.
+    ///
+    /// One pass per parameter over its f32 values, in place: the same f32 arithmetic, value for
+    /// value, as the candle tensor expressions this replaces (`m * β1 + g * (1 - β1)`, ...;
+    /// the test `fused_adamw_matches_the_tensor_formula` keeps that), without their dozen
+    /// temporary tensors per parameter.
+    pub fn update_sum(&mut self, vars: &BTreeMap<String, Var>, parts: &[candle_core::backprop::GradStore]) -> candle_core::Result<()> {
         self.step += 1;
         let t = self.step as i32;
         let c1 = 1.0 - self.beta1.powi(t);
         let c2 = 1.0 - self.beta2.powi(t);
+        let k = AdamWConstants {
+            beta1: self.beta1 as f32,
+            one_minus_beta1: (1.0 - self.beta1) as f32,
+            beta2: self.beta2 as f32,
+            one_minus_beta2: (1.0 - self.beta2) as f32,
+            inv_c1: (1.0 / c1) as f32,
+            inv_c2: (1.0 / c2) as f32,
+            eps: self.eps as f32,
+            lr: self.lr as f32,
+            decay: (self.weight_decay > 0.0).then_some((1.0 - self.lr * self.weight_decay) as f32),
+        };
+        let mut sum: Vec<f32> = Vec::new();
         for (name, var) in vars {
-            let Some(g) = grads.get(var.as_tensor()) else { continue };
-            let (m, v) = match self.moments.get(name) {
-                Some((m, v)) => (m.clone(), v.clone()),
-                None => (g.zeros_like()?, g.zeros_like()?),
-            };
-            let m = ((m * self.beta1)? + (g * (1.0 - self.beta1))?)?;
-            let v = ((v * self.beta2)? + (g.sqr()? * (1.0 - self.beta2))?)?;
-            let update = ((&m / c1)? / ((&v / c2)?.sqrt()? + self.eps)?)?;
-            let mut next = var.as_tensor().clone();
-            if self.weight_decay > 0.0 {
-                next = (&next * (1.0 - self.lr * self.weight_decay))?;
+            let grads: Vec<Tensor> = parts.iter().filter_map(|p| p.get(var.as_tensor())).map(Tensor::contiguous).collect::<candle_core::Result<_>>()?;
+            let Some(first) = grads.first() else { continue };
+            let n = var.as_tensor().elem_count();
+            sum.clear();
+            with_f32(first, "gradient", |g| {
+                sum.extend_from_slice(g);
+                Ok(())
+            })?;
+            for g in &grads[1..] {
+                with_f32(g, "gradient", |g| {
+                    sum.iter_mut().zip(g).for_each(|(a, b)| *a += b);
+                    Ok(())
+                })?;
             }
-            next = (next - (update * self.lr)?)?;
-            var.set(&next)?;
-            self.moments.insert(name.clone(), (m, v));
+            if sum.len() != n {
+                candle_core::bail!("AdamW: {name} has {n} values, its gradient {}", sum.len());
+            }
+            let moments =
+                self.moments.entry(name.clone()).or_insert_with(|| Moments { m: vec![0.0; n], v: vec![0.0; n], shape: var.as_tensor().shape().clone() });
+            if moments.m.len() != n || moments.v.len() != n {
+                candle_core::bail!("AdamW: {name} has {n} values, its saved moments {}", moments.m.len());
+            }
+            let op = AdamWStep { k, grad: &sum, m: std::cell::RefCell::new(&mut moments.m), v: std::cell::RefCell::new(&mut moments.v) };
+            var.as_tensor().inplace_op1(&op)?;
         }
         Ok(())
     }
 
     /// Moments as named tensors (`m.<name>`, `v.<name>`) for a safetensors file.
-    pub fn state(&self) -> BTreeMap<String, Tensor> {
+    pub fn state(&self) -> candle_core::Result<BTreeMap<String, Tensor>> {
         let mut out = BTreeMap::new();
-        for (name, (m, v)) in &self.moments {
-            out.insert(format!("m.{name}"), m.clone());
-            out.insert(format!("v.{name}"), v.clone());
+        for (name, moments) in &self.moments {
+            out.insert(format!("m.{name}"), Tensor::from_slice(&moments.m, moments.shape.clone(), &Device::Cpu)?);
+            out.insert(format!("v.{name}"), Tensor::from_slice(&moments.v, moments.shape.clone(), &Device::Cpu)?);
         }
-        out
+        Ok(out)
     }
 
     /// Restore moments saved by `state`.
-    pub fn load_state(&mut self, tensors: &std::collections::HashMap<String, Tensor>, step: u64) {
+    pub fn load_state(&mut self, tensors: &std::collections::HashMap<String, Tensor>, step: u64) -> candle_core::Result<()> {
         self.step = step;
         self.moments.clear();
+        let values = |t: &Tensor| t.to_dtype(DType::F32)?.flatten_all()?.to_vec1::<f32>();
         for (key, m) in tensors {
             if let Some(name) = key.strip_prefix("m.") {
                 if let Some(v) = tensors.get(&format!("v.{name}")) {
-                    self.moments.insert(name.to_string(), (m.clone(), v.clone()));
+                    self.moments.insert(name.to_string(), Moments { m: values(m)?, v: values(v)?, shape: m.shape().clone() });
                 }
             }
         }
+        Ok(())
     }
+}
+
+/// AdamW's per-step constants, in f32 as candle's `tensor * f64` applies them.
+#[derive(Clone, Copy, Debug)]
+struct AdamWConstants {
+    beta1: f32,
+    one_minus_beta1: f32,
+    beta2: f32,
+    one_minus_beta2: f32,
+    inv_c1: f32,
+    inv_c2: f32,
+    eps: f32,
+    lr: f32,
+    /// `1 - lr * weight_decay` when there is weight decay.
+    decay: Option<f32>,
+}
+
+/// One parameter's AdamW update, written into the parameter in place.
+struct AdamWStep<'a> {
+    k: AdamWConstants,
+    grad: &'a [f32],
+    m: std::cell::RefCell<&'a mut Vec<f32>>,
+    v: std::cell::RefCell<&'a mut Vec<f32>>,
+}
+
+impl candle_core::InplaceOp1 for AdamWStep<'_> {
+    fn name(&self) -> &'static str {
+        "adamw-step"
+    }
+
+    fn cpu_fwd(&self, storage: &mut CpuStorage, layout: &Layout) -> candle_core::Result<()> {
+        let CpuStorage::F32(data) = storage else { candle_core::bail!("AdamW: parameters must be f32") };
+        let Some((start, end)) = layout.contiguous_offsets() else { candle_core::bail!("AdamW: parameters must be contiguous") };
+        let w = &mut data[start..end];
+        let (mut m, mut v) = (self.m.borrow_mut(), self.v.borrow_mut());
+        if w.len() != self.grad.len() || m.len() != w.len() || v.len() != w.len() {
+            candle_core::bail!("AdamW: {} values, gradient {}, moments {}", w.len(), self.grad.len(), m.len());
+        }
+        let k = self.k;
+        // Each line is one candle op of the tensor formula: `x * a` is `x * a + 0` (affine).
+        for (((w, m), v), &g) in w.iter_mut().zip(m.iter_mut()).zip(v.iter_mut()).zip(self.grad) {
+            *m = (*m * k.beta1 + 0.0) + (g * k.one_minus_beta1 + 0.0);
+            *v = (*v * k.beta2 + 0.0) + ((g * g) * k.one_minus_beta2 + 0.0);
+            let update = (*m * k.inv_c1 + 0.0) / ((*v * k.inv_c2 + 0.0).sqrt() * 1.0 + k.eps);
+            if let Some(decay) = k.decay {
+                *w = *w * decay + 0.0;
+            }
+            *w -= update * k.lr + 0.0;
+        }
+        Ok(())
+    }
+}
+
+/// Runs `f` on the values of a contiguous CPU f32 tensor in place.
+fn with_f32<R>(t: &Tensor, what: &str, f: impl FnOnce(&[f32]) -> candle_core::Result<R>) -> candle_core::Result<R> {
+    let (storage, layout) = t.storage_and_layout();
+    let candle_core::Storage::Cpu(CpuStorage::F32(data)) = &*storage else { candle_core::bail!("{what}: expected f32 values on the CPU") };
+    let Some((start, end)) = layout.contiguous_offsets() else { candle_core::bail!("{what}: expected a contiguous tensor") };
+    f(&data[start..end])
 }
 
 /// The variables of `varmap` by name, in name order.
@@ -96,6 +199,70 @@ pub fn named_vars(varmap: &VarMap) -> BTreeMap<String, Var> {
 #[derive(Clone, Copy, Debug)]
 pub struct StepStats {
     pub loss: f64,
+}
+
+/// The crops of one skeleton (or augmented variant) in a step, in batch order, with their
+/// diffusion steps and the noise drawn for them: one sub-batch of the model.
+pub struct GroupDraw {
+    pub crops: Vec<Crop>,
+    pub steps: Vec<u32>,
+    /// `(B, T, J, dims)` of the group's padded batch (T = the longest crop + the P_S token).
+    pub shape: (usize, usize, usize, usize),
+    /// Gaussian noise for the motion tokens, `B * T * J * dims` values (token 0 unused).
+    noise: Vec<f32>,
+}
+
+/// What a training step draws from its data stream, all of it before any model work: the
+/// crops, their diffusion steps, then the noise of each group in the order the groups first
+/// appear in the batch (the order the stream always had). So the draws never depend on how
+/// the groups are then spread over threads.
+pub struct StepDraw {
+    pub groups: Vec<GroupDraw>,
+    /// Real motion tokens of the whole batch (frames 1.. of real joints): the rotation
+    /// term's normaliser, and times `dims` the MSE's.
+    pub tokens: f64,
+    pub dims: usize,
+    /// Values the velocity term covers (pairs of real consecutive motion frames, times joints
+    /// and dims), or none when a group has fewer than 2 motion frames (then the term is off
+    /// for the step, as it always was).
+    pub velocity_values: Option<f64>,
+}
+
+/// Draw `batch` crops and timesteps, group the crops by skeleton (or variant), and draw each
+/// group's noise (see `StepDraw`).
+pub fn draw_step(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batch: usize, crop: usize) -> Result<StepDraw, NnError> {
+    let crops = set.sample(rng, batch, crop);
+    let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
+    let mut order: Vec<(usize, Option<usize>)> = Vec::new();
+    for c in &crops {
+        if !order.contains(&(c.skeleton, c.variant)) {
+            order.push((c.skeleton, c.variant));
+        }
+    }
+    if order.is_empty() {
+        return Err(NnError::Shape { what: "training batch", expected: "at least one crop".into(), got: vec![0] });
+    }
+    let (mut tokens, mut pairs, mut velocity) = (0usize, 0usize, true);
+    let mut dims = 0;
+    let mut groups = Vec::with_capacity(order.len());
+    for key in order {
+        let chosen: Vec<usize> = (0..crops.len()).filter(|&i| (crops[i].skeleton, crops[i].variant) == key).collect();
+        let part_crops: Vec<Crop> = chosen.iter().map(|&i| crops[i]).collect();
+        let part_steps: Vec<u32> = chosen.iter().map(|&i| steps[i]).collect();
+        let clip = |c: &Crop| &set.data(c).clips[c.clip];
+        let b = part_crops.len();
+        let t = part_crops.iter().map(|c| c.frames).max().unwrap_or(0) + 1;
+        let j = part_crops.iter().map(|c| clip(c).joints).max().unwrap_or(0);
+        dims = clip(&part_crops[0]).dims;
+        for c in &part_crops {
+            tokens += c.frames * clip(c).joints;
+            pairs += c.frames.saturating_sub(1) * clip(c).joints;
+        }
+        velocity &= t > 2;
+        let noise = gaussian(rng, b * t * j * dims);
+        groups.push(GroupDraw { crops: part_crops, steps: part_steps, shape: (b, t, j, dims), noise });
+    }
+    Ok(StepDraw { groups, tokens: tokens as f64, dims, velocity_values: velocity.then_some((pairs * dims) as f64) })
 }
 
 /// The training loss of one batch: draw `batch` crops and timesteps, noise the motion (never
@@ -111,6 +278,9 @@ pub struct StepStats {
 /// sub-batch: padding every crop to the batch's largest skeleton (88 joints for the centipede
 /// next to 14 for the fish) would spend most of the attention work on padding. The model gives
 /// a clip the same output alone or padded (nn tests), so this changes the cost, not the loss.
+///
+/// This is the whole batch's loss as one graph for one backward pass: the reference that
+/// `step_gradients` (what training runs) is checked against.
 #[allow(clippy::too_many_arguments)]
 pub fn training_loss(
     model: &Denoiser,
@@ -123,20 +293,10 @@ pub fn training_loss(
     lambda_vel: f64,
     device: &Device,
 ) -> Result<Tensor, NnError> {
-    let crops = set.sample(rng, batch, crop);
-    let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
-    let mut order: Vec<(usize, Option<usize>)> = Vec::new();
-    for c in &crops {
-        if !order.contains(&(c.skeleton, c.variant)) {
-            order.push((c.skeleton, c.variant));
-        }
-    }
+    let draw = draw_step(set, schedule, rng, batch, crop)?;
     let mut total: Option<LossSums> = None;
-    for key in order {
-        let chosen: Vec<usize> = (0..crops.len()).filter(|&i| (crops[i].skeleton, crops[i].variant) == key).collect();
-        let part_crops: Vec<Crop> = chosen.iter().map(|&i| crops[i]).collect();
-        let part_steps: Vec<u32> = chosen.iter().map(|&i| steps[i]).collect();
-        let part = loss_sums(model, set, schedule, &part_crops, &part_steps, rng, lambda_geo != 0.0, lambda_vel != 0.0, device)?;
+    for group in &draw.groups {
+        let part = loss_sums(model, set, group, lambda_geo != 0.0, lambda_vel != 0.0, schedule, device)?;
         total = Some(match total {
             None => part,
             Some(t) => LossSums {
@@ -165,6 +325,84 @@ pub fn training_loss(
     Ok(loss)
 }
 
+/// The loss of a drawn step and its gradient, as one gradient store per group (in group
+/// order; `AdamW::update_sum` adds them in that order).
+///
+/// The loss is a sum over groups: each group's squared errors, rotation distances and
+/// velocity errors over the whole batch's normalisers, which the draw knows before any
+/// forward pass. So each group's share is a loss of its own, with its own forward and
+/// backward pass, and the groups run in parallel on the current rayon pool (spread by
+/// estimated cost; a thread that runs out of groups helps with the others' matmuls). What a
+/// group computes does not depend on which thread runs it, and the shares are added in group
+/// order, so the loss and the gradients are the same bytes for any number of threads.
+/// Returns the loss (the shares' sum, in f64) and the gradients.
+pub fn step_gradients(
+    model: &Denoiser,
+    set: &TrainSet,
+    schedule: &Schedule,
+    draw: &StepDraw,
+    lambda_geo: f64,
+    lambda_vel: f64,
+    device: &Device,
+) -> Result<(f64, Vec<GradStore>), NnError> {
+    use rayon::prelude::*;
+    let values = draw.tokens * draw.dims as f64;
+    let velocity_values = draw.velocity_values.filter(|_| lambda_vel != 0.0);
+    let share = |group: &GroupDraw| -> Result<(f64, GradStore), NnError> {
+        let sums = loss_sums(model, set, group, lambda_geo != 0.0, velocity_values.is_some(), schedule, device)?;
+        let mut loss = (sums.squared / values.max(1.0))?;
+        if let Some(rotation) = sums.rotation {
+            loss = (&loss + ((rotation / draw.tokens.max(1.0))? * lambda_geo)?)?;
+        }
+        if let (Some((velocity, _)), Some(count)) = (sums.velocity, velocity_values) {
+            loss = (&loss + ((velocity / count.max(1.0))? * lambda_vel)?)?;
+        }
+        let value = loss.to_scalar::<f32>()? as f64;
+        Ok((value, loss.backward()?))
+    };
+    let cfg = model.config();
+    let costs: Vec<f64> = draw.groups.iter().map(|g| group_cost(g.shape, cfg.width, cfg.ff, cfg.window)).collect();
+    let lists = balance(&costs, rayon::current_num_threads());
+    type Share = Result<(f64, GradStore), NnError>;
+    let done: Vec<Vec<(usize, Share)>> = lists.into_par_iter().map(|list| list.into_iter().map(|g| (g, share(&draw.groups[g]))).collect()).collect();
+    let mut slots: Vec<Option<Share>> = (0..draw.groups.len()).map(|_| None).collect();
+    for (g, result) in done.into_iter().flatten() {
+        slots[g] = Some(result);
+    }
+    let mut loss = 0.0;
+    let mut grads = Vec::with_capacity(slots.len());
+    for slot in slots {
+        let Some(result) = slot else { return Err(NnError::Shape { what: "training groups", expected: "every group computed".into(), got: vec![] }) };
+        let (value, g) = result?;
+        loss += value;
+        grads.push(g);
+    }
+    Ok((loss, grads))
+}
+
+/// A group's rough cost (multiply-adds of its forward pass), to spread groups over threads.
+fn group_cost((b, t, j, _): (usize, usize, usize, usize), width: usize, ff: usize, window: usize) -> f64 {
+    let tokens = (b * t * j) as f64;
+    let d = width as f64;
+    tokens * (8.0 * d * d + 2.0 * d * ff as f64 + 2.0 * d * (j + t.min(window + 1)) as f64)
+}
+
+/// Items (by cost) into at most `lists` lists, largest first onto the least loaded list
+/// (ties: the lower index), so the lists take about equally long. Only the timing depends on
+/// it, never the result.
+fn balance(costs: &[f64], lists: usize) -> Vec<Vec<usize>> {
+    let n = lists.clamp(1, costs.len().max(1));
+    let mut order: Vec<usize> = (0..costs.len()).collect();
+    order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]).then(a.cmp(&b)));
+    let mut out: Vec<(f64, Vec<usize>)> = vec![(0.0, Vec::new()); n];
+    for i in order {
+        let lightest = (0..n).min_by(|&a, &b| out[a].0.total_cmp(&out[b].0).then(a.cmp(&b))).unwrap_or(0);
+        out[lightest].0 += costs[i];
+        out[lightest].1.push(i);
+    }
+    out.into_iter().map(|(_, l)| l).filter(|l| !l.is_empty()).collect()
+}
+
 /// Unnormalised loss terms of one sub-batch: summed squared error and the number of values it
 /// covers, summed rotation distance (when asked for) and the number of tokens.
 struct LossSums {
@@ -176,18 +414,16 @@ struct LossSums {
     velocity: Option<(Tensor, f64)>,
 }
 
-#[allow(clippy::too_many_arguments)]
 fn loss_sums(
     model: &Denoiser,
     set: &TrainSet,
-    schedule: &Schedule,
-    crops: &[Crop],
-    steps: &[u32],
-    rng: &mut SplitMix64,
+    group: &GroupDraw,
     rotation: bool,
     velocity: bool,
+    schedule: &Schedule,
     device: &Device,
 ) -> Result<LossSums, NnError> {
+    let (crops, steps) = (&group.crops, &group.steps);
     let features: Vec<_> = crops.iter().map(|c| set.crop(c)).collect();
     let items: Vec<BatchItem> = crops
         .iter()
@@ -199,7 +435,10 @@ fn loss_sums(
         .collect();
     let clean = batch_from(&items, steps, device)?;
     let (b, t, j, d) = clean.dims()?;
-    let noise = Tensor::from_vec(gaussian(rng, b * t * j * d), (b, t, j, d), device)?;
+    if (b, t, j, d) != group.shape {
+        return Err(NnError::Shape { what: "training group", expected: format!("{:?}", group.shape), got: vec![b, t, j, d] });
+    }
+    let noise = Tensor::from_slice(&group.noise, (b, t, j, d), device)?;
     let (a, s): (Vec<f32>, Vec<f32>) = steps.iter().map(|&k| schedule.noise_coefficients(k as usize)).map(|(a, s)| (a as f32, s as f32)).unzip();
     let a = Tensor::from_vec(a, (b, 1, 1, 1), device)?;
     let s = Tensor::from_vec(s, (b, 1, 1, 1), device)?;
@@ -249,7 +488,8 @@ fn loss_sums(
     Ok(LossSums { squared, values, rotation: Some(rotation), tokens, velocity })
 }
 
-/// One training step: `training_loss`, backward, AdamW; no update when the loss is not finite.
+/// One training step: `draw_step`, `step_gradients` (the groups in parallel on the current
+/// rayon pool), AdamW; no update when the loss is not finite. Same bytes at any thread count.
 #[allow(clippy::too_many_arguments)]
 pub fn train_step(
     model: &Denoiser,
@@ -264,14 +504,13 @@ pub fn train_step(
     lambda_vel: f64,
     device: &Device,
 ) -> Result<StepStats, NnError> {
-    let loss = training_loss(model, set, schedule, rng, batch, crop, lambda_geo, lambda_vel, device)?;
-    let value = loss.to_scalar::<f32>()? as f64;
+    let draw = draw_step(set, schedule, rng, batch, crop)?;
+    let (value, grads) = step_gradients(model, set, schedule, &draw, lambda_geo, lambda_vel, device)?;
     if !value.is_finite() {
         // No update from a NaN gradient: the caller stops with the model as it was.
         return Ok(StepStats { loss: value });
     }
-    let grads = loss.backward()?;
-    opt.update(vars, &grads)?;
+    opt.update_sum(vars, &grads)?;
     Ok(StepStats { loss: value })
 }
 
@@ -398,7 +637,7 @@ mod tests {
                 let dir = std::env::temp_dir().join(format!("menagerie-train-{}", std::process::id()));
                 std::fs::create_dir_all(&dir).unwrap();
                 varmap.save(dir.join("model.safetensors")).unwrap();
-                candle_core::safetensors::save(&opt.state().into_iter().collect(), dir.join("opt.safetensors")).unwrap();
+                candle_core::safetensors::save(&opt.state().unwrap().into_iter().collect(), dir.join("opt.safetensors")).unwrap();
                 // A new process: fresh (differently seeded) parameters, then the checkpoint.
                 varmap = VarMap::new();
                 model = Denoiser::new(seeded_var_builder(&varmap, 99, &dev), &cfg).unwrap();
@@ -407,7 +646,7 @@ mod tests {
                 let state = candle_core::safetensors::load(dir.join("opt.safetensors"), &dev).unwrap();
                 let step = opt.step;
                 opt = AdamW::new(1e-3);
-                opt.load_state(&state, step);
+                opt.load_state(&state, step).unwrap();
                 let _ = std::fs::remove_dir_all(&dir);
             }
             losses.push(train_step(&model, &vars, &mut opt, set, &schedule, &mut rng, 2, 12, 1.0, 0.0, &dev).unwrap().loss);
@@ -422,6 +661,123 @@ mod tests {
         assert!(a.iter().all(|l| l.is_finite() && *l > 0.0), "{a:?}");
         assert_eq!(a, run(&set, 4, None), "same seed, same losses");
         assert_eq!(a, run(&set, 4, Some(2)), "a resumed run continues the same run");
+    }
+
+    /// Every parameter's values, by name.
+    fn parameters(vars: &BTreeMap<String, Var>) -> BTreeMap<String, Vec<f32>> {
+        vars.iter().map(|(n, v)| (n.clone(), v.as_tensor().flatten_all().unwrap().to_vec1::<f32>().unwrap())).collect()
+    }
+
+    #[test]
+    fn one_and_two_threads_train_the_same_bytes() {
+        let set = set();
+        let dev = Device::Cpu;
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let varmap = VarMap::new();
+                let model = Denoiser::new(seeded_var_builder(&varmap, 3, &dev), &DenoiserConfig::tiny()).unwrap();
+                let vars = named_vars(&varmap);
+                let mut opt = AdamW::new(1e-3);
+                let schedule = Schedule::cosine(100);
+                let losses: Vec<u64> = (0..2)
+                    .map(|k| {
+                        let mut rng = SplitMix64::new(40 + k);
+                        train_step(&model, &vars, &mut opt, &set, &schedule, &mut rng, 6, 12, 1.0, 0.5, &dev).unwrap().loss.to_bits()
+                    })
+                    .collect();
+                (losses, parameters(&vars))
+            })
+        };
+        // Several groups per step (the augmented variants), so the threads share the work.
+        let draw = draw_step(&set, &Schedule::cosine(100), &mut SplitMix64::new(40), 6, 12).unwrap();
+        assert!(draw.groups.len() > 1, "{} groups", draw.groups.len());
+        let (one, two) = (run(1), run(2));
+        assert_eq!(one.0, two.0, "losses");
+        assert!(one.1 == two.1, "parameters differ between 1 and 2 threads");
+        assert_eq!(one, run(2), "and again");
+    }
+
+    #[test]
+    fn per_group_gradients_add_up_to_the_one_graph_gradient() {
+        let set = set();
+        let dev = Device::Cpu;
+        let varmap = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
+        let vars = named_vars(&varmap);
+        let schedule = Schedule::cosine(100);
+        for (geo, vel) in [(1.0, 0.0), (1.0, 1.0), (0.0, 0.5)] {
+            let reference = training_loss(&model, &set, &schedule, &mut SplitMix64::new(9), 6, 12, geo, vel, &dev).unwrap();
+            let want = reference.backward().unwrap();
+            let draw = draw_step(&set, &schedule, &mut SplitMix64::new(9), 6, 12).unwrap();
+            assert!(draw.groups.len() > 1);
+            let (loss, parts) = step_gradients(&model, &set, &schedule, &draw, geo, vel, &dev).unwrap();
+            let expected = reference.to_scalar::<f32>().unwrap() as f64;
+            assert!((loss - expected).abs() < 1e-5 * expected.abs(), "loss {loss} against {expected}");
+            for (name, var) in &vars {
+                let w = want.get(var.as_tensor()).unwrap().flatten_all().unwrap().to_vec1::<f32>().unwrap();
+                let mut sum = vec![0f32; w.len()];
+                for p in &parts {
+                    let g = p.get(var.as_tensor()).unwrap().flatten_all().unwrap().to_vec1::<f32>().unwrap();
+                    sum.iter_mut().zip(&g).for_each(|(a, b)| *a += b);
+                }
+                let scale = w.iter().fold(0f32, |m, v| m.max(v.abs())).max(1e-12);
+                let worst = w.iter().zip(&sum).fold(0f32, |m, (a, b)| m.max((a - b).abs()));
+                assert!(worst <= 1e-4 * scale, "{name} (geo {geo}, vel {vel}): off by {worst}, largest {scale}");
+            }
+        }
+    }
+
+    #[test]
+    fn balance_spreads_costs_and_keeps_every_item() {
+        let lists = balance(&[5.0, 1.0, 4.0, 2.0, 3.0], 2);
+        assert_eq!(lists, vec![vec![0, 3, 1], vec![2, 4]]);
+        assert_eq!(balance(&[1.0, 2.0], 8), vec![vec![1], vec![0]]);
+        assert_eq!(balance(&[3.0], 1), vec![vec![0]]);
+        assert!(balance(&[], 2).is_empty());
+    }
+
+    /// AdamW as candle tensor expressions (how it was written before the fused pass).
+    fn tensor_adamw(opt: &AdamW, w: &Tensor, g: &Tensor, m: &Tensor, v: &Tensor) -> (Tensor, Tensor, Tensor) {
+        let t = opt.step as i32;
+        let c1 = 1.0 - opt.beta1.powi(t);
+        let c2 = 1.0 - opt.beta2.powi(t);
+        let m = ((m * opt.beta1).unwrap() + (g * (1.0 - opt.beta1)).unwrap()).unwrap();
+        let v = ((v * opt.beta2).unwrap() + (g.sqr().unwrap() * (1.0 - opt.beta2)).unwrap()).unwrap();
+        let update = ((&m / c1).unwrap() / ((&v / c2).unwrap().sqrt().unwrap() + opt.eps).unwrap()).unwrap();
+        let mut next = w.clone();
+        if opt.weight_decay > 0.0 {
+            next = (&next * (1.0 - opt.lr * opt.weight_decay)).unwrap();
+        }
+        next = (next - (update * opt.lr).unwrap()).unwrap();
+        (next, m, v)
+    }
+
+    #[test]
+    fn fused_adamw_matches_the_tensor_formula() {
+        let dev = Device::Cpu;
+        let n = 37;
+        for decay in [0.0, 0.01] {
+            let mut rng = SplitMix64::new(7);
+            let w0 = gaussian(&mut rng, n);
+            let var = Var::from_vec(w0.clone(), n, &dev).unwrap();
+            let vars: BTreeMap<String, Var> = [("w".to_string(), var.clone())].into();
+            let mut opt = AdamW::new(3e-3);
+            opt.weight_decay = decay;
+            let zeros = Tensor::zeros(n, DType::F32, &dev).unwrap();
+            let (mut w, mut m, mut v) = (Tensor::from_vec(w0, n, &dev).unwrap(), zeros.clone(), zeros);
+            for _ in 0..5 {
+                // Two gradient parts, as two groups' backward passes give: d(w . a)/dw = a exactly.
+                let (a, b) = (Tensor::from_vec(gaussian(&mut rng, n), n, &dev).unwrap(), Tensor::from_vec(gaussian(&mut rng, n), n, &dev).unwrap());
+                let parts: Vec<GradStore> = [&a, &b].iter().map(|g| (var.as_tensor() * *g).unwrap().sum_all().unwrap().backward().unwrap()).collect();
+                opt.update_sum(&vars, &parts).unwrap();
+                (w, m, v) = tensor_adamw(&opt, &w, &(&a + &b).unwrap(), &m, &v);
+                let bits = |t: &Tensor| t.to_vec1::<f32>().unwrap().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(var.as_tensor()), bits(&w), "parameters, decay {decay}, step {}", opt.step);
+                let state = opt.state().unwrap();
+                assert_eq!((bits(&state["m.w"]), bits(&state["v.w"])), (bits(&m), bits(&v)), "moments, step {}", opt.step);
+            }
+        }
     }
 
     #[test]

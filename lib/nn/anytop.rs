@@ -17,7 +17,8 @@
 //! `(q_i·k_j + q_i·EqD[D_ij] + k_i·EkD[D_ij] + q_i·EqR[R_ij] + k_i·EkR[R_ij]) / sqrt(head_dim)`.
 //! The key-side terms use k at the *query's* joint i, as the reference (GRPE's indexing) does;
 //! the paper's formula writes k_j. Because every bias term is then a function of (i, type), it
-//! is computed as one small matmul per token against the one-hot of (D_ij, R_ij).
+//! is computed once per token, head and type (`fused::topology_coefficients`) and looked up by
+//! (D_ij, R_ij) in the attention kernel.
 //!
 //! Padding (fixes the reference's mask-ordering bug, §9.1): padded joints are masked as keys
 //! of the skeletal attention (per sample), padded frames as keys of the temporal attention,
@@ -32,6 +33,12 @@ use candle_core::{DType, Tensor, D};
 use candle_nn::{Init, VarBuilder};
 use std::sync::Arc;
 
+/// The skeletal attention's topology tables, `[types, d]` each (see `Denoiser::topology_tables`).
+struct Tables {
+    query: Tensor,
+    key: Tensor,
+}
+
 /// Per-forward masks shared by all layers.
 struct Context {
     b: usize,
@@ -44,11 +51,13 @@ struct Context {
     temporal: Keys,
 }
 
-/// `[rows, 3d]` queries, keys and values from one matmul against the stacked weights.
-pub(crate) fn project_qkv(query: &Linear, key: &Linear, value: &Linear, rows: &Tensor) -> candle_core::Result<Tensor> {
+/// `[rows, 3d]` queries, keys and values from one matmul against the stacked weights; `x` is
+/// any shape with `d` last (its rows are all but the last dimension).
+pub(crate) fn project_qkv(query: &Linear, key: &Linear, value: &Linear, x: &Tensor) -> candle_core::Result<Tensor> {
     let w = Tensor::cat(&[query.weight(), key.weight(), value.weight()], 0)?; // [3d, d]
     let b = Tensor::cat(&[query.bias(), key.bias(), value.bias()], 0)?;
-    fused::add_broadcast(&rows.matmul(&w.t()?)?, &b, 1)
+    let d = x.dim(D::Minus1)?;
+    fused::linear(x, &w, &b, Some((x.elem_count() / d.max(1), w.dim(0)?).into()))
 }
 
 #[derive(Clone, Debug)]
@@ -72,16 +81,16 @@ impl SkeletalAttention {
         })
     }
 
-    /// `x`: `[B, T, J, d]`; `bias_projection`: `[3d, H * types]` (see `Denoiser::bias_projection`).
-    fn forward(&self, x: &Tensor, ctx: &Context, bias_projection: &Tensor) -> candle_core::Result<Tensor> {
+    /// `x`: `[B, T, J, d]`.
+    fn forward(&self, x: &Tensor, ctx: &Context, tables: &Tables) -> candle_core::Result<Tensor> {
         let (b, t, j) = (ctx.b, ctx.t, ctx.j);
         let d = x.dim(D::Minus1)?;
-        let qkv = project_qkv(&self.query, &self.key, &self.value, &x.reshape((b * t * j, d))?)?;
+        let qkv = project_qkv(&self.query, &self.key, &self.value, x)?;
         // c[row, h, type] = (q_i·Eq[type] + k_i·Ek[type]) / sqrt(dh): every topology term of
         // the logit (i, j) is c at the query's row for the pair's distance and relation type.
-        let c = qkv.matmul(bias_projection)?;
+        let c = fused::topology_coefficients(&qkv, &tables.query, &tables.key, self.heads)?;
         let y = fused::attention(&qkv, Some(&c), Groups::joints(b, t, j), self.heads, ctx.skeletal.clone())?;
-        self.out.forward(&y)?.reshape((b, t, j, d))
+        self.out.forward_shaped(&y, (b, t, j, d))
     }
 }
 
@@ -110,9 +119,9 @@ impl TemporalAttention {
     fn forward(&self, x: &Tensor, ctx: &Context) -> candle_core::Result<Tensor> {
         let (b, t, j) = (ctx.b, ctx.t, ctx.j);
         let d = x.dim(D::Minus1)?;
-        let qkv = project_qkv(&self.query, &self.key, &self.value, &x.reshape((b * t * j, d))?)?;
+        let qkv = project_qkv(&self.query, &self.key, &self.value, x)?;
         let y = fused::attention(&qkv, None, Groups::frames(b, t, j), self.heads, ctx.temporal.clone())?;
-        self.out.forward(&y)?.reshape((b, t, j, d))
+        self.out.forward_shaped(&y, (b, t, j, d))
     }
 }
 
@@ -142,9 +151,9 @@ impl Layer {
     }
 
     /// `temb`: `[B, 1, 1, d]`.
-    fn forward(&self, x: &Tensor, temb: &Tensor, ctx: &Context, bias_projection: &Tensor) -> candle_core::Result<Tensor> {
+    fn forward(&self, x: &Tensor, temb: &Tensor, ctx: &Context, tables: &Tables) -> candle_core::Result<Tensor> {
         let x = fused::add_broadcast(x, &self.timestep.forward(temb)?, x.dim(0)?)?;
-        let x = self.norm1.forward(&(&x + self.skeletal.forward(&x, ctx, bias_projection)?)?)?;
+        let x = self.norm1.forward(&(&x + self.skeletal.forward(&x, ctx, tables)?)?)?;
         let x = self.norm2.forward(&(&x + self.temporal.forward(&x, ctx)?)?)?;
         self.norm3.forward(&(&x + self.ff.forward(&x)?)?)
     }
@@ -275,9 +284,9 @@ impl Denoiser {
         let h = Tensor::cat(&[rest, motion], 1)?;
         let mut h = fused::add_broadcast(&h, &self.names_in.forward(&names)?, b)?.broadcast_add(&sinusoid(&batch.positions, self.cfg.width)?.unsqueeze(2)?)?;
         let temb = sinusoid(&batch.timesteps.to_dtype(DType::F32)?, self.cfg.width)?.reshape((b, 1, 1, self.cfg.width))?;
-        let bias_projection = self.bias_projection()?;
+        let tables = self.topology_tables()?;
         for (l, layer) in self.layers.iter().take(layers).enumerate() {
-            h = layer.forward(&h, &temb, &ctx, &bias_projection)?;
+            h = layer.forward(&h, &temb, &ctx, &tables)?;
             visit(l, &h);
         }
         Ok((h, x, token_mask))
@@ -323,34 +332,9 @@ impl Denoiser {
         Ok(Context { b, t, j, skeletal, temporal })
     }
 
-    /// The topology tables as one `[3d, H * types]` matrix for the fused q/k/v rows: the query
-    /// block maps head h's query to `Eq[type]·q` in column `h * types + type`, the key block
-    /// likewise for `Ek`, the value block is zero; scaled by 1/sqrt(head_dim) like the logits.
-    /// Types are the `dmax + 1` distances, then the 6 relations.
-    fn bias_projection(&self) -> candle_core::Result<Tensor> {
-        let (h, dh, d) = (self.cfg.heads, self.cfg.head_dim(), self.cfg.width);
-        let types = self.cfg.dmax + 1 + RELATION_TYPES;
-        let dev = self.distance_query.device();
-        let mut block = vec![0f32; d * h * types];
-        for row in 0..d {
-            for ty in 0..types {
-                block[row * h * types + (row / dh) * types + ty] = 1.0;
-            }
-        }
-        let block = Tensor::from_vec(block, (d, h * types), dev)?;
-        let per_head = |a: &Tensor, b: &Tensor| -> candle_core::Result<Tensor> {
-            // [types, d] -> [d, types] -> repeated per head, kept on the head's own rows.
-            Tensor::cat(&[a, b], 0)?.t()?.repeat((1, h))?.mul(&block)
-        };
-        let scale = 1.0 / (dh as f64).sqrt();
-        let projection = Tensor::cat(
-            &[
-                per_head(&self.distance_query, &self.relation_query)?,
-                per_head(&self.distance_key, &self.relation_key)?,
-                Tensor::zeros((d, h * types), DType::F32, dev)?,
-            ],
-            0,
-        )?;
-        projection * scale
+    /// The topology tables as `[types, d]` query and key tables (types: the `dmax + 1`
+    /// distances, then the 6 relations), for `fused::topology_coefficients`.
+    fn topology_tables(&self) -> candle_core::Result<Tables> {
+        Ok(Tables { query: Tensor::cat(&[&self.distance_query, &self.relation_query], 0)?, key: Tensor::cat(&[&self.distance_key, &self.relation_key], 0)? })
     }
 }

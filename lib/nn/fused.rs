@@ -564,14 +564,105 @@ struct LayerNormOp {
 }
 
 impl LayerNormOp {
-    /// Per row: the normalised values (into `xhat`) and 1/sigma.
+    /// Per row: the normalised values (into `xhat`) and 1/sigma. Sums with eight partial sums
+    /// (see `sum`), and plain index loops: this is inlined into `target_feature` functions, where
+    /// a closure would be compiled without the feature.
+    #[inline(always)]
     fn normalise(&self, x: &[f32], xhat: &mut [f32]) -> f32 {
         let n = x.len() as f32;
-        let mean = x.iter().sum::<f32>() / n;
-        let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f32>() / n;
+        let mean = sum(x) / n;
+        for e in 0..x.len() {
+            xhat[e] = x[e] - mean;
+        }
+        let var = dot(xhat, xhat) / n;
         let rstd = 1.0 / (var + self.eps).sqrt();
-        xhat.iter_mut().zip(x).for_each(|(o, v)| *o = (v - mean) * rstd);
+        for v in xhat.iter_mut() {
+            *v *= rstd;
+        }
         rstd
+    }
+
+    #[inline(always)]
+    fn forward_body(&self, x: &[f32], w: &[f32], b: &[f32]) -> Vec<f32> {
+        let d = w.len();
+        let mut y = vec![0f32; x.len()];
+        for (xr, yr) in x.chunks_exact(d).zip(y.chunks_exact_mut(d)) {
+            self.normalise(xr, yr);
+            for e in 0..d {
+                yr[e] = yr[e] * w[e] + b[e];
+            }
+        }
+        y
+    }
+
+    /// The same loops compiled for 8-wide vectors.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn forward_avx2(&self, x: &[f32], w: &[f32], b: &[f32]) -> Vec<f32> {
+        self.forward_body(x, w, b)
+    }
+
+    fn forward(&self, x: &[f32], w: &[f32], b: &[f32]) -> Vec<f32> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, the only feature `forward_avx2` is compiled for.
+            return unsafe { self.forward_avx2(x, w, b) };
+        }
+        self.forward_body(x, w, b)
+    }
+
+    /// `(dx, dw, db)` from the input, weight and output gradient.
+    #[inline(always)]
+    fn backward_body(&self, xv: &[f32], wv: &[f32], dy: &[f32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        let d = wv.len();
+        let n = d as f32;
+        let mut dx = vec![0f32; xv.len()];
+        let (mut dw, mut db) = (vec![0f32; d], vec![0f32; d]);
+        let mut xhat = vec![0f32; d];
+        let mut g = vec![0f32; d];
+        for ((xr, dyr), dxr) in xv.chunks_exact(d).zip(dy.chunks_exact(d)).zip(dx.chunks_exact_mut(d)) {
+            let rstd = self.normalise(xr, &mut xhat);
+            for e in 0..d {
+                dw[e] += dyr[e] * xhat[e];
+                db[e] += dyr[e];
+                g[e] = dyr[e] * wv[e];
+            }
+            // dx = rstd (g - mean(g) - xhat mean(g xhat))
+            let mean_g = sum(&g) / n;
+            let mean_gx = dot(&g, &xhat) / n;
+            for e in 0..d {
+                dxr[e] = rstd * (g[e] - mean_g - xhat[e] * mean_gx);
+            }
+        }
+        (dx, dw, db)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn backward_avx2(&self, xv: &[f32], wv: &[f32], dy: &[f32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        self.backward_body(xv, wv, dy)
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn backward(&self, x: &Tensor, w: &Tensor, b: &Tensor, xv: &[f32], wv: &[f32], dy: &[f32]) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let d = wv.len();
+        if d == 0 || xv.len() % d != 0 || dy.len() != xv.len() {
+            candle_core::bail!("layer norm backward: input of {} values, weight {d}, output gradient {}", xv.len(), dy.len());
+        }
+        #[cfg(target_arch = "x86_64")]
+        let (dx, dw, db) = if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, the only feature `backward_avx2` is compiled for.
+            unsafe { self.backward_avx2(xv, wv, dy) }
+        } else {
+            self.backward_body(xv, wv, dy)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let (dx, dw, db) = self.backward_body(xv, wv, dy);
+        Ok((
+            Some(Tensor::from_vec(dx, x.shape(), x.device())?),
+            Some(Tensor::from_vec(dw, w.shape(), w.device())?),
+            Some(Tensor::from_vec(db, b.shape(), b.device())?),
+        ))
     }
 }
 
@@ -586,49 +677,13 @@ impl CustomOp3 for LayerNormOp {
         if d == 0 || b.len() != d || x.len() % d != 0 {
             candle_core::bail!("layer norm: input of {} values, weight {d}, bias {}", x.len(), b.len());
         }
-        let mut y = vec![0f32; x.len()];
-        for (xr, yr) in x.chunks_exact(d).zip(y.chunks_exact_mut(d)) {
-            self.normalise(xr, yr);
-            yr.iter_mut().zip(w.iter().zip(b)).for_each(|(v, (w, b))| *v = *v * w + b);
-        }
-        Ok((CpuStorage::F32(y), l1.shape().clone()))
+        Ok((CpuStorage::F32(self.forward(x, w, b)), l1.shape().clone()))
     }
 
     fn bwd(&self, x: &Tensor, w: &Tensor, b: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
         with_values(x, "layer norm input", |xv| {
             with_values(w, "layer norm weight", |wv| with_values(grad, "layer norm output gradient", |dy| self.backward(x, w, b, xv, wv, dy)))
         })
-    }
-}
-
-impl LayerNormOp {
-    #[allow(clippy::type_complexity)]
-    fn backward(&self, x: &Tensor, w: &Tensor, b: &Tensor, xv: &[f32], wv: &[f32], dy: &[f32]) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        let d = wv.len();
-        let mut dx = vec![0f32; xv.len()];
-        let (mut dw, mut db) = (vec![0f32; d], vec![0f32; d]);
-        let mut xhat = vec![0f32; d];
-        let mut g = vec![0f32; d];
-        for ((xr, dyr), dxr) in xv.chunks_exact(d).zip(dy.chunks_exact(d)).zip(dx.chunks_exact_mut(d)) {
-            let rstd = self.normalise(xr, &mut xhat);
-            for e in 0..d {
-                dw[e] += dyr[e] * xhat[e];
-                db[e] += dyr[e];
-                g[e] = dyr[e] * wv[e];
-            }
-            // dx = rstd (g - mean(g) - xhat mean(g xhat))
-            let n = d as f32;
-            let mean_g = g.iter().sum::<f32>() / n;
-            let mean_gx = g.iter().zip(&xhat).map(|(a, b)| a * b).sum::<f32>() / n;
-            for e in 0..d {
-                dxr[e] = rstd * (g[e] - mean_g - xhat[e] * mean_gx);
-            }
-        }
-        Ok((
-            Some(Tensor::from_vec(dx, x.shape(), x.device())?),
-            Some(Tensor::from_vec(dw, w.shape(), w.device())?),
-            Some(Tensor::from_vec(db, b.shape(), b.device())?),
-        ))
     }
 }
 
@@ -690,6 +745,304 @@ pub fn add_broadcast(x: &Tensor, v: &Tensor, groups: usize) -> Result<Tensor> {
     let width = m / groups;
     let op = AddBroadcast { groups, rows: n / m, width };
     x.contiguous()?.apply_op2(&v.contiguous()?, op)
+}
+
+/// The parallelism candle's own CPU matmul uses (`Rayon(n)` for n = RAYON_NUM_THREADS or the
+/// CPU count), so our GEMMs split work as candle's do: a fixed number of parts, not the size
+/// of the rayon pool they happen to run in. The result is the same bytes either way.
+fn matmul_parallelism() -> gemm::Parallelism {
+    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    match *THREADS.get_or_init(candle_core::utils::get_num_threads) {
+        n if n > 1 => gemm::Parallelism::Rayon(n),
+        _ => gemm::Parallelism::None,
+    }
+}
+
+/// `a b` as a new contiguous row-major `m x n` buffer, for views `a` (m x k) and `b` (k x n),
+/// with the gemm call candle's matmul makes (so the same bytes as `matmul`).
+fn matmul_new(a: &[f32], am: Strided, b: &[f32], bm: Strided, (m, n, k): (usize, usize, usize)) -> Result<Vec<f32>> {
+    if !am.fits(a.len(), m, k) || !bm.fits(b.len(), k, n) {
+        candle_core::bail!("fused kernel: a {m} x {k} by {k} x {n} product does not fit its buffers");
+    }
+    let len = m.checked_mul(n).ok_or_else(|| candle_core::Error::Msg(format!("fused kernel: a {m} x {n} product is too large")))?;
+    if len == 0 || k == 0 {
+        return Ok(vec![0f32; len]);
+    }
+    let mut d: Vec<f32> = Vec::with_capacity(len);
+    // SAFETY: the views fit their slices (checked above) and `d` has room for the m x n
+    // destination, a fresh allocation that overlaps neither. With `read_dst` false gemm
+    // (0.19, `gemm_basic_generic`) sets alpha to zero and writes every destination element
+    // without reading it, so no zero fill is needed (it was 1-2% of a training step), and
+    // after the call all `len` values are initialised.
+    unsafe {
+        gemm::gemm(
+            m,
+            n,
+            k,
+            d.as_mut_ptr(),
+            1,
+            n as isize,
+            false,
+            a.as_ptr().add(am.off),
+            am.cs as isize,
+            am.rs as isize,
+            b.as_ptr().add(bm.off),
+            bm.cs as isize,
+            bm.rs as isize,
+            0.0,
+            1.0,
+            false,
+            false,
+            false,
+            matmul_parallelism(),
+        );
+        d.set_len(len);
+    }
+    Ok(d)
+}
+
+/// `y = x W^T + b` over the last dimension of `x` as one graph node. The forward is what
+/// `x.matmul(W.t())` plus the bias gives, to the bit (the same gemm call, then the bias added to
+/// each row); the backward gives `dx = dy W`, `dW = dy^T x` and `db` = the column sums of dy
+/// in one go. Built from candle's ops a linear was four nodes (reshape, transpose, matmul,
+/// bias add, reshape back), and candle's backward pass zero-fills and adds a fresh gradient
+/// buffer for every input of every node: that was a tenth of a training step (perf).
+#[derive(Clone, Debug)]
+struct LinearOp {
+    rows: usize,
+    inputs: usize,
+    outputs: usize,
+    shape: Shape,
+}
+
+impl CustomOp3 for LinearOp {
+    fn name(&self) -> &'static str {
+        "fused-linear"
+    }
+
+    fn cpu_fwd(&self, s1: &CpuStorage, l1: &Layout, s2: &CpuStorage, l2: &Layout, s3: &CpuStorage, l3: &Layout) -> Result<(CpuStorage, Shape)> {
+        let (x, w, b) = (f32_slice(s1, l1, "linear input")?, f32_slice(s2, l2, "linear weight")?, f32_slice(s3, l3, "linear bias")?);
+        let (rows, i, o) = (self.rows, self.inputs, self.outputs);
+        if x.len() != rows * i || w.len() != o * i || b.len() != o {
+            candle_core::bail!("fused linear: input of {} values, weight {}, bias {}, for {rows} rows of {i} -> {o}", x.len(), w.len(), b.len());
+        }
+        let mut y = matmul_new(x, Strided { off: 0, rs: i, cs: 1 }, w, Strided { off: 0, rs: 1, cs: i }, (rows, o, i))?;
+        for r in y.chunks_exact_mut(o.max(1)) {
+            r.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+        }
+        Ok((CpuStorage::F32(y), self.shape.clone()))
+    }
+
+    fn bwd(&self, x: &Tensor, w: &Tensor, b: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let (rows, i, o) = (self.rows, self.inputs, self.outputs);
+        let (dx, dw, db) = with_values(grad, "linear output gradient", |dy| {
+            if dy.len() != rows * o {
+                candle_core::bail!("fused linear: output gradient of {} values, expected {rows} x {o}", dy.len());
+            }
+            let dx =
+                with_values(w, "linear weight", |wv| matmul_new(dy, Strided { off: 0, rs: o, cs: 1 }, wv, Strided { off: 0, rs: i, cs: 1 }, (rows, i, o)))?;
+            let dw = with_values(x, "linear input", |xv| matmul_new(dy, Strided { off: 0, rs: 1, cs: o }, xv, Strided { off: 0, rs: i, cs: 1 }, (o, i, rows)))?;
+            let mut db = vec![0f32; o];
+            for r in dy.chunks_exact(o.max(1)) {
+                db.iter_mut().zip(r).for_each(|(a, b)| *a += b);
+            }
+            Ok((dx, dw, db))
+        })?;
+        Ok((
+            Some(Tensor::from_vec(dx, x.shape(), x.device())?),
+            Some(Tensor::from_vec(dw, w.shape(), w.device())?),
+            Some(Tensor::from_vec(db, b.shape(), b.device())?),
+        ))
+    }
+}
+
+/// `x W^T + b` over the last dimension of `x` (`weight`: `[outputs, inputs]`, `bias`:
+/// `[outputs]`), shaped `shape` (which must hold `rows x outputs` values; `None`: `x`'s shape
+/// with the last dimension `outputs`). One graph node; see `LinearOp`.
+pub fn linear(x: &Tensor, weight: &Tensor, bias: &Tensor, shape: Option<Shape>) -> Result<Tensor> {
+    let (outputs, inputs) = weight.dims2()?;
+    let dims = x.dims();
+    if dims.last() != Some(&inputs) || bias.elem_count() != outputs {
+        candle_core::bail!("fused linear: input {dims:?}, weight [{outputs}, {inputs}], bias of {}", bias.elem_count());
+    }
+    let rows = x.elem_count() / inputs.max(1);
+    let shape = match shape {
+        Some(s) if s.elem_count() == rows * outputs => s,
+        Some(s) => candle_core::bail!("fused linear: {rows} x {outputs} values do not make {s:?}"),
+        None => {
+            let mut d = dims.to_vec();
+            if let Some(last) = d.last_mut() {
+                *last = outputs;
+            }
+            Shape::from(d)
+        }
+    };
+    let op = LinearOp { rows, inputs, outputs, shape };
+    x.contiguous()?.apply_op3(&weight.contiguous()?, &bias.contiguous()?, op)
+}
+
+/// `d = beta a b` (`d += beta a b` when `accumulate`) for views `d` (m x n), `a` (m x k) and
+/// `b` (k x n), with the parallelism of candle's matmul; an error, not a panic, when a view
+/// overruns its buffer.
+#[allow(clippy::too_many_arguments)]
+fn strided_gemm(
+    d: &mut [f32],
+    dm: Strided,
+    a: &[f32],
+    am: Strided,
+    b: &[f32],
+    bm: Strided,
+    (m, n, k): (usize, usize, usize),
+    beta: f32,
+    accumulate: bool,
+) -> Result<()> {
+    if !dm.fits(d.len(), m, n) || !am.fits(a.len(), m, k) || !bm.fits(b.len(), k, n) {
+        candle_core::bail!("fused kernel: a {m} x {k} by {k} x {n} product does not fit its buffers");
+    }
+    if m == 0 || n == 0 || k == 0 {
+        if !accumulate && k == 0 {
+            candle_core::bail!("fused kernel: empty inner dimension");
+        }
+        return Ok(());
+    }
+    // SAFETY: every element the three views address is inside its slice (checked above), and
+    // `d` is borrowed mutably, so it overlaps neither `a` nor `b`.
+    unsafe {
+        gemm::gemm(
+            m,
+            n,
+            k,
+            d.as_mut_ptr().add(dm.off),
+            dm.cs as isize,
+            dm.rs as isize,
+            accumulate,
+            a.as_ptr().add(am.off),
+            am.cs as isize,
+            am.rs as isize,
+            b.as_ptr().add(bm.off),
+            bm.cs as isize,
+            bm.rs as isize,
+            1.0,
+            beta,
+            false,
+            false,
+            false,
+            matmul_parallelism(),
+        )
+    }
+    Ok(())
+}
+
+/// The skeletal attention's topology coefficients (see `anytop`): for every token row, head h
+/// and type t, `c[row, h, t] = (q_h . Eq[t]_h + k_h . Ek[t]_h) / sqrt(head_dim)`, where `_h` is
+/// head h's slice of the width. As one `[3d, H * types]` matrix product this was mostly zeros
+/// (the value rows, and the other heads' rows of each column): six times the multiply-adds
+/// needed. Here it is two GEMMs per head over that head's slice only, and the same in the
+/// backward pass.
+#[derive(Clone, Copy, Debug)]
+struct TopologyCoefficients {
+    rows: usize,
+    heads: usize,
+    head_dim: usize,
+    types: usize,
+    scale: f32,
+}
+
+impl TopologyCoefficients {
+    fn width(&self) -> usize {
+        self.heads * self.head_dim
+    }
+
+    fn check(&self, qkv: usize, eq: usize, ek: usize) -> Result<()> {
+        let w = self.width();
+        if qkv != self.rows * 3 * w || eq != self.types * w || ek != self.types * w {
+            candle_core::bail!(
+                "topology coefficients: q/k/v of {qkv} values, tables of {eq} and {ek}, for {} rows of width {w} and {} types",
+                self.rows,
+                self.types
+            );
+        }
+        Ok(())
+    }
+
+    /// Head h's queries (`part` 0) or keys (1): `rows x head_dim` inside the q/k/v matrix.
+    fn tokens(&self, part: usize, h: usize) -> Strided {
+        Strided { off: part * self.width() + h * self.head_dim, rs: 3 * self.width(), cs: 1 }
+    }
+
+    /// Head h's slice of a `[types, d]` table: `types x head_dim`.
+    fn table(&self, h: usize) -> Strided {
+        Strided { off: h * self.head_dim, rs: self.width(), cs: 1 }
+    }
+
+    /// Head h's coefficients: `rows x types` inside `[rows, heads * types]`.
+    fn coefficients(&self, h: usize) -> Strided {
+        Strided { off: h * self.types, rs: self.heads * self.types, cs: 1 }
+    }
+}
+
+impl CustomOp3 for TopologyCoefficients {
+    fn name(&self) -> &'static str {
+        "fused-topology-coefficients"
+    }
+
+    fn cpu_fwd(&self, s1: &CpuStorage, l1: &Layout, s2: &CpuStorage, l2: &Layout, s3: &CpuStorage, l3: &Layout) -> Result<(CpuStorage, Shape)> {
+        let (qkv, eq, ek) = (f32_slice(s1, l1, "q/k/v")?, f32_slice(s2, l2, "query table")?, f32_slice(s3, l3, "key table")?);
+        self.check(qkv.len(), eq.len(), ek.len())?;
+        let (rows, dh, ty) = (self.rows, self.head_dim, self.types);
+        let mut c = vec![0f32; rows * self.heads * ty];
+        for h in 0..self.heads {
+            strided_gemm(&mut c, self.coefficients(h), qkv, self.tokens(0, h), eq, self.table(h).t(), (rows, ty, dh), self.scale, false)?;
+            strided_gemm(&mut c, self.coefficients(h), qkv, self.tokens(1, h), ek, self.table(h).t(), (rows, ty, dh), self.scale, true)?;
+        }
+        Ok((CpuStorage::F32(c), Shape::from((rows, self.heads * ty))))
+    }
+
+    fn bwd(&self, qkv: &Tensor, eq: &Tensor, ek: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let (rows, dh, ty) = (self.rows, self.head_dim, self.types);
+        let (dqkv, deq, dek) = with_values(grad, "topology coefficient gradient", |dc| {
+            with_values(qkv, "q/k/v", |qv| {
+                with_values(eq, "query table", |eqv| {
+                    with_values(ek, "key table", |ekv| {
+                        self.check(qv.len(), eqv.len(), ekv.len())?;
+                        if dc.len() != rows * self.heads * ty {
+                            candle_core::bail!("topology coefficients: gradient of {} values, expected {rows} x {}", dc.len(), self.heads * ty);
+                        }
+                        let mut dqkv = vec![0f32; qv.len()];
+                        let (mut deq, mut dek) = (vec![0f32; eqv.len()], vec![0f32; ekv.len()]);
+                        for h in 0..self.heads {
+                            let dch = self.coefficients(h);
+                            for (part, table, dtable) in [(0, eqv, &mut deq), (1, ekv, &mut dek)] {
+                                // d tokens = scale dC E_h;  d E_h = scale dC^T tokens.
+                                strided_gemm(&mut dqkv, self.tokens(part, h), dc, dch, table, self.table(h), (rows, dh, ty), self.scale, false)?;
+                                strided_gemm(dtable, self.table(h), dc, dch.t(), qv, self.tokens(part, h), (ty, dh, rows), self.scale, false)?;
+                            }
+                        }
+                        Ok((dqkv, deq, dek))
+                    })
+                })
+            })
+        })?;
+        Ok((
+            Some(Tensor::from_vec(dqkv, qkv.shape(), qkv.device())?),
+            Some(Tensor::from_vec(deq, eq.shape(), eq.device())?),
+            Some(Tensor::from_vec(dek, ek.shape(), ek.device())?),
+        ))
+    }
+}
+
+/// The skeletal attention's topology coefficients `[rows, heads * types]` from the q/k/v
+/// matrix `[rows, 3d]` and the query and key tables `[types, d]`, scaled by
+/// `1/sqrt(head_dim)`: see `TopologyCoefficients`.
+pub fn topology_coefficients(qkv: &Tensor, query_table: &Tensor, key_table: &Tensor, heads: usize) -> Result<Tensor> {
+    let (rows, w3) = qkv.dims2()?;
+    let (types, w) = query_table.dims2()?;
+    if heads == 0 || w % heads != 0 || w3 != 3 * w || key_table.dims() != query_table.dims() {
+        candle_core::bail!("topology coefficients: q/k/v {rows} x {w3}, tables {:?} and {:?}, {heads} heads", query_table.dims(), key_table.dims());
+    }
+    let head_dim = w / heads;
+    let op = TopologyCoefficients { rows, heads, head_dim, types, scale: 1.0 / (head_dim as f32).sqrt() };
+    qkv.contiguous()?.apply_op3(&query_table.contiguous()?, &key_table.contiguous()?, op)
 }
 
 #[cfg(test)]

@@ -133,18 +133,25 @@ fn temporal_attention_case(t: usize, half: usize) {
 
 #[test]
 fn layer_norm_matches_basic_ops() {
+    // 8: whole vectors of eight; 13: a remainder (the sums run in eight lanes).
+    for width in [8, 13] {
+        layer_norm_case(width);
+    }
+}
+
+fn layer_norm_case(width: usize) {
     let dev = Device::Cpu;
     let mut rng = SplitMix64::new(5);
-    let x = Var::from_vec(random(&mut rng, 6 * 8), (2, 3, 8), &dev).unwrap();
-    let wt = Var::from_vec(random(&mut rng, 8), 8, &dev).unwrap();
-    let bs = Var::from_vec(random(&mut rng, 8), 8, &dev).unwrap();
+    let x = Var::from_vec(random(&mut rng, 6 * width), (2, 3, width), &dev).unwrap();
+    let wt = Var::from_vec(random(&mut rng, width), width, &dev).unwrap();
+    let bs = Var::from_vec(random(&mut rng, width), width, &dev).unwrap();
     let fused = layer_norm(x.as_tensor(), wt.as_tensor(), bs.as_tensor(), 1e-5).unwrap();
     let xt = x.as_tensor();
     let centred = xt.broadcast_sub(&xt.mean_keepdim(D::Minus1).unwrap()).unwrap();
     let var = centred.sqr().unwrap().mean_keepdim(D::Minus1).unwrap();
     let reference =
         centred.broadcast_div(&(var + 1e-5).unwrap().sqrt().unwrap()).unwrap().broadcast_mul(wt.as_tensor()).unwrap().broadcast_add(bs.as_tensor()).unwrap();
-    assert_eq!(fused.dims(), &[2, 3, 8]);
+    assert_eq!(fused.dims(), &[2, 3, width]);
     assert!(max_diff(&fused, &reference) < 1e-5);
     let gf = weighted_sum(&fused, 1).backward().unwrap();
     let gr = weighted_sum(&reference, 1).backward().unwrap();
@@ -196,4 +203,81 @@ fn fast_exp_is_accurate_and_exactly_zero_for_masked_keys() {
     assert_eq!(super::exp(0.0), 1.0);
     assert_eq!(super::exp(f32::NEG_INFINITY), 0.0);
     assert_eq!(super::exp(-1e9), 0.0);
+}
+
+#[test]
+fn linear_matches_basic_ops() {
+    let dev = Device::Cpu;
+    let mut rng = SplitMix64::new(8);
+    for (dims, inputs, outputs) in [(vec![2, 3, 5], 5, 7), (vec![70, 16], 16, 48), (vec![1, 4], 4, 1)] {
+        let n: usize = dims.iter().product();
+        let x = Var::from_vec(random(&mut rng, n), dims.as_slice(), &dev).unwrap();
+        let w = Var::from_vec(random(&mut rng, outputs * inputs), (outputs, inputs), &dev).unwrap();
+        let b = Var::from_vec(random(&mut rng, outputs), outputs, &dev).unwrap();
+        let fused = linear(x.as_tensor(), w.as_tensor(), b.as_tensor(), None).unwrap();
+        let rows = n / inputs;
+        let mut out_dims = dims.clone();
+        *out_dims.last_mut().unwrap() = outputs;
+        let reference = x
+            .as_tensor()
+            .reshape((rows, inputs))
+            .unwrap()
+            .matmul(&w.as_tensor().t().unwrap())
+            .unwrap()
+            .broadcast_add(b.as_tensor())
+            .unwrap()
+            .reshape(out_dims.as_slice())
+            .unwrap();
+        assert_eq!(fused.dims(), out_dims.as_slice());
+        assert_eq!(values(&fused).unwrap(), values(&reference).unwrap(), "the forward is candle's matmul and bias add, to the bit");
+        let gf = weighted_sum(&fused, 4).backward().unwrap();
+        let gr = weighted_sum(&reference, 4).backward().unwrap();
+        for (name, var) in [("x", &x), ("weight", &w), ("bias", &b)] {
+            let (a, r) = (gf.get(var.as_tensor()).unwrap(), gr.get(var.as_tensor()).unwrap());
+            assert!(max_diff(a, r) < 1e-5, "{name} gradient differs by {}", max_diff(a, r));
+        }
+        // Another shape for the same values.
+        let flat = linear(x.as_tensor(), w.as_tensor(), b.as_tensor(), Some((rows * outputs,).into())).unwrap();
+        assert_eq!(values(&flat).unwrap(), values(&fused).unwrap());
+    }
+    let x = Tensor::zeros((3, 4), candle_core::DType::F32, &dev).unwrap();
+    let w = Tensor::zeros((2, 5), candle_core::DType::F32, &dev).unwrap();
+    assert!(linear(&x, &w, &Tensor::zeros(2, candle_core::DType::F32, &dev).unwrap(), None).is_err(), "4 inputs against a weight for 5");
+    let w = Tensor::zeros((2, 4), candle_core::DType::F32, &dev).unwrap();
+    assert!(linear(&x, &w, &Tensor::zeros(2, candle_core::DType::F32, &dev).unwrap(), Some((7,).into())).is_err(), "6 values do not make 7");
+}
+
+#[test]
+fn topology_coefficients_match_the_projection_matrix() {
+    let dev = Device::Cpu;
+    let (rows, heads, dh, types) = (13, 3, 4, 5);
+    let w = heads * dh;
+    let mut rng = SplitMix64::new(10);
+    let qkv = Var::from_vec(random(&mut rng, rows * 3 * w), (rows, 3 * w), &dev).unwrap();
+    let eq = Var::from_vec(random(&mut rng, types * w), (types, w), &dev).unwrap();
+    let ek = Var::from_vec(random(&mut rng, types * w), (types, w), &dev).unwrap();
+    let fused = topology_coefficients(qkv.as_tensor(), eq.as_tensor(), ek.as_tensor(), heads).unwrap();
+    // How the model computed it before: one [3w, heads * types] matrix, each head's block on
+    // its own rows, the value rows zero.
+    let mut block = vec![0f32; w * heads * types];
+    for row in 0..w {
+        for ty in 0..types {
+            block[row * heads * types + (row / dh) * types + ty] = 1.0;
+        }
+    }
+    let block = Tensor::from_vec(block, (w, heads * types), &dev).unwrap();
+    let per_head = |t: &Tensor| t.t().unwrap().repeat((1, heads)).unwrap().mul(&block).unwrap();
+    let projection =
+        Tensor::cat(&[per_head(eq.as_tensor()), per_head(ek.as_tensor()), Tensor::zeros((w, heads * types), candle_core::DType::F32, &dev).unwrap()], 0)
+            .unwrap();
+    let reference = (qkv.as_tensor().matmul(&projection).unwrap() * (1.0 / (dh as f64).sqrt())).unwrap();
+    assert_eq!(fused.dims(), &[rows, heads * types]);
+    assert!(max_diff(&fused, &reference) < 1e-5, "forward differs by {}", max_diff(&fused, &reference));
+    let gf = weighted_sum(&fused, 11).backward().unwrap();
+    let gr = weighted_sum(&reference, 11).backward().unwrap();
+    for (name, var) in [("q/k/v", &qkv), ("query table", &eq), ("key table", &ek)] {
+        let (a, r) = (gf.get(var.as_tensor()).unwrap(), gr.get(var.as_tensor()).unwrap());
+        assert!(max_diff(a, r) < 1e-5, "{name} gradient differs by {}", max_diff(a, r));
+    }
+    assert!(topology_coefficients(qkv.as_tensor(), eq.as_tensor(), ek.as_tensor(), 5).is_err(), "12 is no multiple of 5 heads");
 }

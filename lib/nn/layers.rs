@@ -13,8 +13,6 @@ use candle_nn::{Init, VarBuilder};
 pub struct Linear {
     weight: Tensor,
     bias: Tensor,
-    inputs: usize,
-    outputs: usize,
 }
 
 impl Linear {
@@ -25,7 +23,7 @@ impl Linear {
         let init = Init::Uniform { lo: -bound, up: bound };
         let weight = vb.get_with_hints((outputs, inputs), "weight", init)?;
         let bias = vb.get_with_hints(outputs, "bias", init)?;
-        Ok(Linear { weight, bias, inputs, outputs })
+        Ok(Linear { weight, bias })
     }
 
     /// Weight and bias initialised to zero: a new path added to a trained model starts
@@ -33,7 +31,7 @@ impl Linear {
     pub fn zeros(vb: VarBuilder, inputs: usize, outputs: usize) -> Result<Linear> {
         let weight = vb.get_with_hints((outputs, inputs), "weight", Init::Const(0.0))?;
         let bias = vb.get_with_hints(outputs, "bias", Init::Const(0.0))?;
-        Ok(Linear { weight, bias, inputs, outputs })
+        Ok(Linear { weight, bias })
     }
 
     pub fn weight(&self) -> &Tensor {
@@ -45,15 +43,12 @@ impl Linear {
     }
 
     pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
-        let dims = x.dims().to_vec();
-        let rows: usize = dims[..dims.len().saturating_sub(1)].iter().product();
-        let flat = x.reshape((rows, self.inputs))?;
-        let y = super::fused::add_broadcast(&flat.matmul(&self.weight.t()?)?, &self.bias, 1)?;
-        let mut out = dims;
-        if let Some(last) = out.last_mut() {
-            *last = self.outputs;
-        }
-        y.reshape(out)
+        super::fused::linear(x, &self.weight, &self.bias, None)
+    }
+
+    /// `forward`, the result shaped `shape` (same values, no reshape node in the graph).
+    pub fn forward_shaped(&self, x: &Tensor, shape: impl Into<candle_core::Shape>) -> Result<Tensor> {
+        super::fused::linear(x, &self.weight, &self.bias, Some(shape.into()))
     }
 }
 
