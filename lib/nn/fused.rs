@@ -646,7 +646,7 @@ impl LayerNormOp {
     #[allow(clippy::type_complexity)]
     fn backward(&self, x: &Tensor, w: &Tensor, b: &Tensor, xv: &[f32], wv: &[f32], dy: &[f32]) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
         let d = wv.len();
-        if d == 0 || xv.len() % d != 0 || dy.len() != xv.len() {
+        if d == 0 || !xv.len().is_multiple_of(d) || dy.len() != xv.len() {
             candle_core::bail!("layer norm backward: input of {} values, weight {d}, output gradient {}", xv.len(), dy.len());
         }
         #[cfg(target_arch = "x86_64")]
