@@ -85,7 +85,7 @@ struct Extracted {
 
 fn extract_all(model: &Frozen, s: &Skeleton, m: &Motion, name: &str) -> anyhow::Result<Extracted> {
     let prepared = dift::prepare(&model.info, s, m, name)?;
-    let schedule = Schedule::cosine(model.info.schedule_steps);
+    let schedule = model.info.schedule();
     let cond = prepared.condition.condition();
     let (mut per_joint, mut shifted_all) = (Vec::new(), Vec::new());
     let started = Instant::now();

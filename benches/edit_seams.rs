@@ -45,7 +45,7 @@ fn main() {
     let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, None).expect("condition");
     let stats = &condition.stats;
     let cond = condition.condition();
-    let schedule = Schedule::cosine(loaded.info.schedule_steps);
+    let schedule = loaded.info.schedule();
 
     let quarter = frames / 4;
     let mut mask = KeepMask::new(frames, j);

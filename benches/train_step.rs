@@ -116,8 +116,19 @@ fn main() {
         joints.join(", ")
     );
 
-    let opts =
-        AnyTopOptions { config: config.clone(), seed, lr: 1e-4, batch, crop, lambda_geo: 1.0, lambda_vel: 0.0, ema: 0.999, augment: 0.0, augment_variants: 0 };
+    let opts = AnyTopOptions {
+        config: config.clone(),
+        seed,
+        lr: 1e-4,
+        batch,
+        crop,
+        lambda_geo: 1.0,
+        lambda_vel: 0.0,
+        ema: 0.999,
+        noise_shift: 1.0,
+        augment: 0.0,
+        augment_variants: 0,
+    };
     let dev = Device::Cpu;
     let scratch = std::env::temp_dir().join(format!("menagerie-train-bench-{}", std::process::id()));
     let mut runs: Vec<(usize, rayon::ThreadPool, AnyTopTrainer, f64)> = threads

@@ -45,7 +45,7 @@ fn main() -> anyhow::Result<()> {
         load_motions(&files, &LoadOptions::default())?.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
     let names = NameTable::builtin()?;
     let (set, _) = TrainSet::build(clips, names, loaded.info.dmax, &Augmentation::none())?;
-    let schedule = Schedule::cosine(loaded.info.schedule_steps);
+    let schedule = loaded.info.schedule();
     let mut rng = SplitMix64::new(5);
     let crops = set.sample(&mut rng, 24, 60);
     println!("| t | motion ratio, raw (pred / clean) | after a 5-frame average | normalised MSE |");
@@ -74,6 +74,65 @@ fn main() -> anyhow::Result<()> {
             n += x0.len() as f64;
         }
         println!("| {t} | {:.3} | {:.3} | {:.4} |", ratio_num / ratio_den.max(1e-12), smooth_num / smooth_den.max(1e-12), mse / n);
+    }
+    sensitivity(&loaded.model, &set, &schedule, &crops, &device)?;
+    Ok(())
+}
+
+/// Does the denoiser read its input across time? Per t: nudge the noisy input at one frame
+/// (every joint and dim, +0.5 normalised units) and report the mean absolute change of the
+/// predicted x0 at frame offsets 0, 1, 3, 8 and 15 from the nudged frame, next to how much two
+/// different noise draws change the prediction (0 = the prediction ignores the noise, so every
+/// sample from pure noise would be the same).
+fn sensitivity(
+    model: &menagerie::nn::Denoiser,
+    set: &TrainSet,
+    schedule: &Schedule,
+    crops: &[menagerie::diffusion::data::Crop],
+    device: &Device,
+) -> anyhow::Result<()> {
+    let offsets = [0usize, 1, 3, 8, 15];
+    println!();
+    println!("| t | change of x0 at offset 0 / 1 / 3 / 8 / 15 after a nudge at one frame | change between two noise draws |");
+    println!("|---|---|---|");
+    let mut rng = SplitMix64::new(9);
+    for t in [10usize, 50, 75, 90, 99] {
+        let mut change = vec![0.0f64; offsets.len()];
+        let (mut draws, mut n) = (0.0f64, 0.0f64);
+        for c in crops.iter().take(8) {
+            let s = set.data(c);
+            let clean: Features = set.crop(c);
+            if clean.frames < 40 {
+                continue;
+            }
+            let (a, b) = schedule.noise_coefficients(t);
+            let width = clean.joints * clean.dims;
+            let noisy_with =
+                |noise: &[f32]| Features { data: clean.data.iter().zip(noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() };
+            let predict = |f: &Features| -> anyhow::Result<Vec<f32>> {
+                let item =
+                    BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 };
+                let batch = batch_from(&[item], &[t as u32], device)?;
+                Ok(model.forward(&batch)?.narrow(1, 1, f.frames)?.contiguous()?.flatten_all()?.to_vec1()?)
+            };
+            let noise = menagerie::rng::gaussian(&mut rng, clean.data.len());
+            let base = noisy_with(&noise);
+            let p0 = predict(&base)?;
+            let at = 10;
+            let mut nudged = base.clone();
+            nudged.data[at * width..(at + 1) * width].iter_mut().for_each(|v| *v += 0.5);
+            let p1 = predict(&nudged)?;
+            for (k, &o) in offsets.iter().enumerate() {
+                let f = at + o;
+                change[k] += (f * width..(f + 1) * width).map(|i| (p1[i] - p0[i]).abs() as f64).sum::<f64>() / width as f64;
+            }
+            let other = noisy_with(&menagerie::rng::gaussian(&mut rng, clean.data.len()));
+            let p2 = predict(&other)?;
+            draws += p0.iter().zip(&p2).map(|(x, y)| (x - y).abs() as f64).sum::<f64>() / p0.len() as f64;
+            n += 1.0;
+        }
+        let row: Vec<String> = change.iter().map(|c| format!("{:.4}", c / n.max(1.0))).collect();
+        println!("| {t} | {} | {:.4} |", row.join(" / "), draws / n.max(1.0));
     }
     Ok(())
 }

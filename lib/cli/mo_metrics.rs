@@ -545,8 +545,8 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
 }
 
 /// The movement metrics (`metrics::movement`) of the samples and of baselines made from the
-/// clips: the clips left out one at a time, their static mean pose and random crops, as many
-/// and as long as the samples.
+/// clips: the clips left out one at a time, their static mean pose and random crops (at
+/// least as many as the samples, two per clip) as long as the samples.
 fn movement_report(gt: &[Loaded], gen: &[Loaded], gt_points: &[PointClip], gen_points: &[PointClip], seed: u64) -> anyhow::Result<Value> {
     let world = |ls: &[Loaded]| -> anyhow::Result<Vec<Clip>> { ls.iter().map(clip_of).collect() };
     let (gt_world, gen_world) = (world(gt)?, world(gen)?);

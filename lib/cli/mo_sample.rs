@@ -7,7 +7,7 @@ use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit::{self, KeepMask};
 use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
-use crate::diffusion::{Sampler, Schedule};
+use crate::diffusion::Sampler;
 use crate::io::{self, npy};
 use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
 use crate::repr::smooth::lambda_for_cutoff;
@@ -215,7 +215,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         bail!("--blend must be a duration in seconds (>= 0), found {}", args.blend);
     }
     let blend = (args.blend * fps).round() as usize;
-    let schedule = Schedule::cosine(loaded.info.schedule_steps);
+    let schedule = loaded.info.schedule();
     let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler, seed: args.common.seed };
     let started = std::time::Instant::now();
     let mut samples = match (&reference, &mask) {

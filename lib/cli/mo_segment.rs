@@ -8,7 +8,7 @@ use crate::bvh;
 use crate::cli::bounds;
 use crate::cli::load::{is_dash, read_skeleton, split_samples};
 use crate::cli::CommonOpts;
-use crate::diffusion::{checkpoint, Schedule};
+use crate::diffusion::checkpoint;
 use crate::dift::{self, DiftOptions};
 use crate::document::AnyTopSection;
 use crate::io::{self, npy};
@@ -201,7 +201,7 @@ pub fn dift_features(model: &checkpoint::Frozen, input: &Input, opts: &DiftOptio
         bail!("{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input", input.name);
     };
     let prepared = dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name)?;
-    let schedule = Schedule::cosine(model.info.schedule_steps);
+    let schedule = model.info.schedule();
     let f = dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, &candle_core::Device::Cpu)
         .with_context(|| input.name.clone())?;
     Ok(f.per_frame().into_iter().map(|row| row.into_iter().map(f64::from).collect()).collect())

@@ -114,6 +114,12 @@ pub struct Args {
     /// raw weights. An average over about 1/(1 - decay) steps.
     #[arg(long, value_name = "DECAY", default_value_t = 0.999, value_parser = parse_decay)]
     pub ema: f64,
+    /// anytop: divide the cosine noise schedule's signal-to-noise ratio by S² at every step, so
+    /// the slow, whole-crop directions of motion are drowned in noise early enough for sampling
+    /// to choose a motion over many steps instead of settling on the mean pose in the first.
+    /// 1 = AnyTop's schedule. A new run only: a resumed run keeps its checkpoint's.
+    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = bounds::positive(crate::diffusion::checkpoint::MAX_NOISE_SHIFT))]
+    pub noise_shift: f64,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
@@ -240,6 +246,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             bail!("{flag} must be a weight >= 0, found {w}");
         }
     }
+    if args.noise_shift < 1.0 {
+        bail!("--noise-shift must be at least 1 (1 = AnyTop's schedule), found {}", args.noise_shift);
+    }
     let device = Device::Cpu;
     let done = match args.arch {
         Arch::Anytop => {
@@ -254,6 +263,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 augment: args.augment,
                 augment_variants: args.augment_variants as usize,
                 ema: args.ema,
+                noise_shift: args.noise_shift,
             };
             // The checkpoint first: a resumed run must rebuild the data (augmented variants
             // included) from the seed the run started with.

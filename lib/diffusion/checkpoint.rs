@@ -114,7 +114,22 @@ pub struct CheckpointInfo {
     /// raw weights (and checkpoints written before the average existed).
     #[serde(default)]
     pub ema: f64,
+    /// The noise schedule's shift (`Schedule::cosine_shifted`); 1 in checkpoints written
+    /// before it existed.
+    #[serde(default = "no_shift")]
+    pub noise_shift: f64,
     pub skeletons: Vec<TrainedSkeleton>,
+}
+
+fn no_shift() -> f64 {
+    1.0
+}
+
+impl CheckpointInfo {
+    /// The noise schedule the model was trained with: sampling must use the same one.
+    pub fn schedule(&self) -> crate::diffusion::Schedule {
+        crate::diffusion::Schedule::cosine_shifted(self.schedule_steps, self.noise_shift)
+    }
 }
 
 /// Save model, optimiser and info to `dir` (created if needed). All three files are written
@@ -182,6 +197,8 @@ pub fn read_dir_files(dir: &Path) -> Result<(Vec<u8>, Vec<u8>), CheckpointError>
 
 /// Diffusion steps a checkpoint may declare (ours train with 100).
 pub const MAX_SCHEDULE_STEPS: usize = 10_000;
+/// The largest noise-schedule shift a checkpoint may carry (log-SNR moved by 2·ln 100 ≈ 9).
+pub const MAX_NOISE_SHIFT: f64 = 100.0;
 
 /// `checkpoint.json`'s description, checked to be ours and of this version.
 fn parse_info(info_json: &[u8]) -> Result<CheckpointInfo, CheckpointError> {
@@ -190,6 +207,9 @@ fn parse_info(info_json: &[u8]) -> Result<CheckpointInfo, CheckpointError> {
         return Err(CheckpointError::Invalid(format!("checkpoint.json: format {} version {}, expected {FORMAT} version {VERSION}", info.format, info.version)));
     }
     // The noise schedule is rebuilt from this count; 0 or 1 steps is no schedule at all.
+    if !(info.noise_shift.is_finite() && (1.0..=MAX_NOISE_SHIFT).contains(&info.noise_shift)) {
+        return Err(CheckpointError::Invalid(format!("checkpoint.json: noise_shift is {}, expected 1 to {MAX_NOISE_SHIFT}", info.noise_shift)));
+    }
     if !(2..=MAX_SCHEDULE_STEPS).contains(&info.schedule_steps) {
         return Err(CheckpointError::Invalid(format!("checkpoint.json: schedule_steps is {}, expected 2 to {MAX_SCHEDULE_STEPS}", info.schedule_steps)));
     }

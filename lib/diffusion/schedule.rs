@@ -30,6 +30,37 @@ impl Schedule {
         Schedule::from_betas(betas)
     }
 
+    /// The cosine schedule with its signal-to-noise ratio divided by `shift`² at every step
+    /// (log-SNR moved down by 2·ln `shift`; 1 = the plain cosine schedule). Why: a motion crop's
+    /// features are strongly correlated over frames and joints, so along its slow directions
+    /// (the pose held over a crop, a gait's phase) the variance is hundreds of times a single
+    /// feature's. At the cosine schedule's late steps those directions still show through the
+    /// noise, so the whole choice of *which* motion falls into the first sampling step, where
+    /// the model can only predict the mean pose: samples stand still. Shifting the schedule
+    /// (as for high-resolution images, Hoogeboom et al. 2023) spreads that choice over many steps.
+    pub fn cosine_shifted(steps: usize, shift: f64) -> Schedule {
+        let plain = Schedule::cosine(steps);
+        if shift == 1.0 {
+            return plain;
+        }
+        let offset = 2.0 * shift.ln();
+        let shifted: Vec<f64> = plain
+            .alpha_bars
+            .iter()
+            .map(|&ab| {
+                let log_snr = (ab / (1.0 - ab)).ln() - offset;
+                1.0 / (1.0 + (-log_snr).exp())
+            })
+            .collect();
+        let mut betas = Vec::with_capacity(shifted.len());
+        let mut previous = 1.0;
+        for &ab in &shifted {
+            betas.push((1.0 - ab / previous).clamp(0.0, 0.999));
+            previous = ab;
+        }
+        Schedule::from_betas(betas)
+    }
+
     fn from_betas(betas: Vec<f64>) -> Schedule {
         let mut alpha_bars = Vec::with_capacity(betas.len());
         let mut acc = 1.0;
@@ -141,6 +172,20 @@ mod tests {
         assert!(s.alpha_bars[99] < 1e-4 && s.alpha_bars[0] > 0.999);
         let (a, b) = s.noise_coefficients(50);
         assert!((a * a + b * b - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_shift_divides_every_steps_signal_to_noise_ratio() {
+        let plain = Schedule::cosine(100);
+        assert_eq!(Schedule::cosine_shifted(100, 1.0), plain);
+        let shifted = Schedule::cosine_shifted(100, 4.0);
+        assert_eq!(shifted.len(), 100);
+        let snr = |ab: f64| ab / (1.0 - ab);
+        for t in 0..99 {
+            let (p, s) = (plain.alpha_bars[t], shifted.alpha_bars[t]);
+            assert!((snr(s) * 16.0 / snr(p) - 1.0).abs() < 1e-6, "t = {t}: {s} against {p}");
+            assert!(shifted.alpha_bars[t + 1] < s, "ᾱ falls at t = {t}");
+        }
     }
 
     #[test]

@@ -228,6 +228,9 @@ pub struct AnyTopOptions {
     /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
     /// 0 = none.
     pub ema: f64,
+    /// The noise schedule's shift for a new run (`Schedule::cosine_shifted`; a resumed run
+    /// keeps its checkpoint's).
+    pub noise_shift: f64,
 }
 
 /// A denoiser checkpoint to continue, with its optimiser state.
@@ -284,7 +287,6 @@ impl AnyTopTrainer {
     /// `resume`, on `set`, saving to `out`. A new run's set is built with `opts.seed` and
     /// `topology::DEFAULT_DMAX`, a resumed one's with its checkpoint's.
     pub fn new(out: &Path, opts: &AnyTopOptions, resume: Option<AnyTopResume>, set: TrainSet, device: &Device) -> Result<AnyTopTrainer, TrainError> {
-        let schedule = Schedule::cosine(100);
         let (varmap, model, opt, mut info, raw) = match resume {
             Some(r) => (r.loaded.varmap, r.loaded.model, r.opt, r.loaded.info, r.raw),
             None => {
@@ -297,7 +299,7 @@ impl AnyTopTrainer {
                     config: opts.config.clone(),
                     step: 0,
                     seed: opts.seed,
-                    schedule_steps: schedule.len(),
+                    schedule_steps: 100,
                     lr: opts.lr,
                     batch: opts.batch,
                     crop: opts.crop,
@@ -305,11 +307,13 @@ impl AnyTopTrainer {
                     augment: 0.0,
                     augment_variants: 0,
                     ema: 0.0,
+                    noise_shift: opts.noise_shift,
                     skeletons: Vec::new(),
                 };
                 (varmap, model, AdamW::new(opts.lr), info, Default::default())
             }
         };
+        let schedule = info.schedule();
         info.augment = opts.augment;
         info.augment_variants = opts.augment_variants;
         info.skeletons = set

@@ -412,14 +412,17 @@ impl<'a> Reference<'a> {
         (vec![clip; count], vec![point; count])
     }
 
-    /// `count` crops of `frames` frames (or whole clips, when shorter) at seeded random places
-    /// of the clips, as world and point clips.
+    /// At least `count` crops of `frames` frames (or whole clips, when shorter) at seeded
+    /// random places of the clips, as world and point clips. The crops take the clips in turn,
+    /// at least two from each: a handful of crops drawn from clips at random can all land in
+    /// the idle clip, and the baseline would then say that real motion barely moves.
     pub fn random_crops(&self, count: usize, frames: usize, seed: u64) -> (Vec<Clip>, Vec<PointClip>) {
         let mut rng = SplitMix64::new(seed);
+        let count = count.max(2 * self.clips.len());
         let mut world = Vec::with_capacity(count);
         let mut points = Vec::with_capacity(count);
-        for _ in 0..count {
-            let c = rng.below(self.clips.len());
+        for i in 0..count {
+            let c = i % self.clips.len();
             let (clip, point) = (&self.clips[c], &self.points[c]);
             let len = frames.min(clip.frames).min(point.frames());
             let start = rng.below(clip.frames.min(point.frames()) - len + 1);
@@ -520,6 +523,9 @@ mod tests {
         let r = Reference::new(&clips, &pts, &MovementOptions::default()).unwrap();
         let (a, pa) = r.random_crops(3, 60, 7);
         let (b, _) = r.random_crops(3, 60, 7);
+        // At least two crops per clip.
+        assert_eq!(a.len(), 3);
+        assert_eq!(r.random_crops(1, 60, 7).0.len(), 2);
         assert_eq!(a.iter().map(|c| c.positions.clone()).collect::<Vec<_>>(), b.iter().map(|c| c.positions.clone()).collect::<Vec<_>>());
         let m = r.score(&a, &pa, None).unwrap();
         assert_eq!(m.nearest_pose, 0.0);
