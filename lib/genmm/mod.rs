@@ -385,9 +385,9 @@ const TRANSITION_FACTOR: f32 = 2.0;
 /// The coarsest synthesis: a seeded random walk through the clips' patches. It starts at a
 /// random patch and runs on in its clip for `segment` patches; then it jumps to a patch whose
 /// predecessor looks like the last patch placed (drawn among the `TRANSITION_CHOICES` best that
-/// are at least a patch away from simply running on and about as close as running on would
+/// are far from simply running on, see `transition`, and about as close as running on would
 /// be), so the pose and its velocity carry over. Without such a jump it runs on, and at a
-/// clip's end it takes the best jump there is. Overlapping patches are averaged, so inside a
+/// clip's end it takes one of the best jumps there are. Overlapping patches are averaged, so inside a
 /// run the blend is the clip itself and a jump cross-fades over a patch between two similar
 /// stretches. Without a usable clip: the clips one after the other, stretched to `len`.
 fn arrangement(clips: &[Channels], weights: &[f32], len: usize, patch: usize, segment: usize, seed: u64) -> Channels {
@@ -445,9 +445,10 @@ fn transition(clips: &[Channels], weights: &[f32], starts: &[usize], last: (usiz
         (false, true) => patch_distance(clip, lb - 1, clip, lb, patch, weights),
         (false, false) => 0.0,
     };
-    // A jump within the same clip goes at least a patch, and at least a third of the clip,
-    // away: short jumps back make short loops.
-    let min_jump = patch.max(clip.frames / 3);
+    // A jump within the same clip goes at least a patch, and at least half the clip, away:
+    // short loops (a third of the corpus flamingo's walk) make the matching rock back and forth
+    // where they close, which looks like standing still for a second or two.
+    let min_jump = patch.max(clip.frames / 2);
     let reach = (patch / 2).max(1);
     let mut minima: Vec<(f32, usize, usize)> = Vec::new();
     for (k, &n) in starts.iter().enumerate() {
