@@ -1,7 +1,7 @@
 complete -c mo-sample -l skeleton -d 'The same as SKELETON, as a named option' -r -F
 complete -c mo-sample -l model -d 'Model directory written by mo-train [default: the built-in model, a small denoiser trained on the synthetic zoo; see models/zoo-small/MODEL_CARD.md]' -r -F
 complete -c mo-sample -s n -l samples -d 'Number of samples' -r
-complete -c mo-sample -l frames -d 'Frames per sample [default: 120; with --reference: the reference\'s length]' -r
+complete -c mo-sample -l frames -d 'Frames per sample [default: 120; with --reference: the reference\'s length; with --examples: the longest clip\'s]' -r
 complete -c mo-sample -l seconds -d 'Length in seconds (at the skeleton\'s frame rate)' -r
 complete -c mo-sample -l steps -d 'Diffusion steps to visit (1..=100)' -r
 complete -c mo-sample -l sampler -d 'Sampler' -r -f -a "ddpm\t''
@@ -10,12 +10,13 @@ complete -c mo-sample -l bvh -d 'Write BVH files instead of NPY (\'{i}\' becomes
 complete -c mo-sample -l reference -d 'A clip of the same skeleton (BVH) to keep parts of (needs --keep-frames or --keep-joints)' -r -F
 complete -c mo-sample -l keep-frames -d 'In-betweening: output frames taken from the reference, e.g. \'0-19,100-119\' (inclusive)' -r
 complete -c mo-sample -l keep-joints -d 'Body-part editing: joints taken from the reference: names or globs (\'*Leg*\'), \'Name/\' for a joint and all its descendants, comma-separated' -r
+complete -c mo-sample -l examples -d 'Example-based generation, no model (GenMM): clips of the skeleton, BVH files or directories of them' -r -F
 complete -c mo-sample -l smooth -d 'Low-pass the generated frames over time: the cutoff in Hz where motion keeps half its amplitude (kept frames and joints stay exact; 0 = the model\'s raw output)' -r
 complete -c mo-sample -l blend -d 'Editing with --smooth: generated frames next to kept ones give way to them over this many seconds, continuing the kept motion instead of jumping to the generated one' -r
 complete -c mo-sample -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-sample -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-sample -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
-complete -c mo-sample -l report -d 'Print seam continuity as one JSON line on stderr (with --reference)'
+complete -c mo-sample -l report -d 'Print seam continuity as one JSON line on stderr (with --reference), or with --examples the synthesis levels and match costs'
 complete -c mo-sample -l no-plant-feet -d 'Keep the model\'s root travel even where it makes planted feet slide (by default the root\'s horizontal motion follows the feet the model puts on the ground)'
 complete -c mo-sample -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-sample -s v -l verbose -d 'Print more about what is happening on stderr'

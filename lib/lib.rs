@@ -27,6 +27,9 @@
 //! * [`diffusion`]: noise schedule, samplers, training data and loop, checkpoints, editing.
 //! * [`sata`]: the SATA topology-agnostic autoencoder (latents for any skeleton).
 //! * [`dift`]: diffusion features, joint and frame correspondence.
+//! * `patch` (crate-private): the patch machinery GenMM and Motion2Motion share (channels,
+//!   pyramid lengths, patch nearest neighbours and blending).
+//! * [`genmm`]: example-based generation from a few clips of a skeleton, no training (GenMM).
 //! * [`retarget`]: Motion2Motion retargeting (patch nearest neighbours over a pyramid).
 //! * [`metrics`]: the papers' metrics, movement and physics scores.
 //! * [`segment`]: temporal segmentation of a motion into actions.
@@ -45,11 +48,13 @@ pub mod diffusion;
 pub mod dift;
 pub mod document;
 pub mod embed;
+pub mod genmm;
 pub mod io;
 pub mod linalg;
 pub mod metrics;
 pub mod motion;
 pub mod nn;
+pub(crate) mod patch;
 pub mod render;
 pub mod repr;
 pub mod retarget;

@@ -5,11 +5,13 @@ For each skeleton folder (one skeleton's clips, e.g. a synthetic-zoo folder writ
 `cargo run --release --example zoo -- --training DIR`), this samples N motions with each model
 (`mo-sample`, the folder's first clip as the skeleton) and compares them with the folder's clips
 (`mo-metrics generation`). Baselines: the clips themselves (`gt`), and whatever models are named
-(e.g. an untrained checkpoint). With --steps-table it also measures one skeleton's quality and
-wall time against sampling steps.
+(e.g. an untrained checkpoint), or 'examples' for example-based generation from the folder's
+own clips (`mo-sample --examples FOLDER`, no model). With --steps-table it also measures one
+skeleton's quality and wall time against sampling steps.
 
     tools/eval_generation.py --bin target/release --model zoo=models/zoo-small \\
-        --model untrained=/tmp/untrained --skeletons /work/zoo/quadruped_v0 /work/zoo/dragon_v7
+        --model untrained=/tmp/untrained --model genmm=examples \\
+        --skeletons /work/zoo/quadruped_v0 /work/zoo/dragon_v7
 
 Only our binaries are run; numbers are printed, nothing is written outside a temp dir.
 """
@@ -85,20 +87,23 @@ def cells(m, ranges=False):
     return [num(m.get(k)) for k, _ in METRICS] + [phys(k) for k, _ in PHYSICS]
 
 
-def sample(bindir, model, skeleton, out, n, frames, steps, sampler, seed):
+def sample(bindir, model, folder, skeleton, out, n, frames, steps, sampler, seed):
     """Samples as BVH files in the new folder `out` (physics needs BVH); returns wall seconds."""
     os.makedirs(out)
-    cmd = [f"{bindir}/mo-sample", skeleton, "-n", str(n), "--frames", str(frames), "--seed", str(seed), "-q",
-           "--bvh", os.path.join(out, "sample_{i}.bvh")]
-    # A model spec is a directory (or 'builtin') and optionally more mo-sample options after it;
-    # its own --steps / --sampler win over the table-wide ones.
+    # A model spec is a directory, 'builtin' or 'examples', and optionally more mo-sample
+    # options after it; its own --steps / --sampler win over the table-wide ones.
     where, *extra = model.split()
-    if "--steps" not in extra:
-        cmd += ["--steps", str(steps)]
-    if "--sampler" not in extra:
-        cmd += ["--sampler", sampler]
-    if where != "builtin":
-        cmd += ["--model", where]
+    common = ["-n", str(n), "--frames", str(frames), "--seed", str(seed), "-q", "--bvh", os.path.join(out, "sample_{i}.bvh")]
+    if where == "examples":
+        cmd = [f"{bindir}/mo-sample", "--examples", folder] + common
+    else:
+        cmd = [f"{bindir}/mo-sample", skeleton] + common
+        if "--steps" not in extra:
+            cmd += ["--steps", str(steps)]
+        if "--sampler" not in extra:
+            cmd += ["--sampler", sampler]
+        if where != "builtin":
+            cmd += ["--model", where]
     cmd += extra
     t = time.monotonic()
     run(cmd)
@@ -112,7 +117,7 @@ def row(cells):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default="target/release")
-    ap.add_argument("--model", action="append", default=[], metavar="NAME=DIR", help="'builtin' as DIR = the embedded model; mo-sample options may follow DIR, e.g. 'raw=builtin --smooth 0'")
+    ap.add_argument("--model", action="append", default=[], metavar="NAME=DIR", help="'builtin' as DIR = the embedded model, 'examples' = mo-sample --examples FOLDER (no model); mo-sample options may follow DIR, e.g. 'raw=builtin --smooth 0'")
     ap.add_argument("--skeletons", nargs="+", required=True, metavar="FOLDER")
     ap.add_argument("-n", type=int, default=8)
     ap.add_argument("--frames", type=int, default=120)
@@ -137,7 +142,7 @@ def main():
         base = None
         for label, model in models:
             out = os.path.join(tmp, f"{name}_{label}")
-            sample(args.bin, model, skeleton, out, args.n, args.frames, args.steps, args.sampler, args.seed)
+            sample(args.bin, model, folder, skeleton, out, args.n, args.frames, args.steps, args.sampler, args.seed)
             m = metrics(args.bin, folder, out, skeleton)
             if base is None:
                 base = m["baselines"]
@@ -157,7 +162,7 @@ def main():
         print(row(["---"] * (3 + len(METRICS) + len(PHYSICS))))
         for sampler, steps in [("ddim", 5), ("ddim", 10), ("ddim", 20), ("ddim", 50), ("ddpm", 20), ("ddpm", 100)]:
             out = os.path.join(tmp, f"steps_{sampler}_{steps}")
-            secs = sample(args.bin, model, skeleton, out, args.n, args.frames, steps, sampler, args.seed)
+            secs = sample(args.bin, model, folder, skeleton, out, args.n, args.frames, steps, sampler, args.seed)
             m = metrics(args.bin, folder, out, skeleton)
             print(row([sampler, str(steps), f"{secs:.1f}"] + cells(m)), flush=True)
 

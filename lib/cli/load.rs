@@ -244,6 +244,46 @@ pub fn expand_inputs(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     Ok(out)
 }
 
+/// One BVH clip of a tool's example clips (`mo-retarget`'s TARGETS, `mo-sample --examples`).
+pub struct BvhClip {
+    pub name: String,
+    pub skeleton: Skeleton,
+    pub motion: Motion,
+}
+
+/// Read one BVH clip; `tool` names the tool in the message an NPY file gets.
+pub fn read_bvh_clip(path: &Path, tool: &str) -> anyhow::Result<BvhClip> {
+    let name = io::display_name(path);
+    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    if npy::looks_like_npy(path, &bytes) {
+        bail!("{name}: {tool} reads BVH files (decode features first: mo-encode --decode)");
+    }
+    let parsed = bvh::parse_bytes(&bytes, &name)?;
+    let skeleton = Skeleton::from_bvh(&parsed);
+    skeleton.validate().with_context(|| name.clone())?;
+    let motion = Motion::from_bvh(&parsed, &skeleton);
+    Ok(BvhClip { name, skeleton, motion })
+}
+
+/// Example clips of one skeleton and one frame rate: BVH files or directories of them (read in
+/// parallel, kept in input order). `what` names them in messages ("target clips").
+pub fn read_example_clips(inputs: &[PathBuf], tool: &str, what: &str) -> anyhow::Result<Vec<BvhClip>> {
+    use rayon::prelude::*;
+    let files = expand_inputs(inputs)?;
+    let clips = files.par_iter().map(|p| read_bvh_clip(p, tool)).collect::<anyhow::Result<Vec<BvhClip>>>()?;
+    let Some(first) = clips.first() else { bail!("no {what} were given") };
+    for c in &clips[1..] {
+        if let Some(why) = first.skeleton.first_difference(&c.skeleton) {
+            bail!("{} and {} have different skeletons ({why}): all {what} must share one skeleton", first.name, c.name);
+        }
+    }
+    let ft = first.motion.frame_time;
+    if let Some(c) = clips.iter().find(|c| (c.motion.frame_time - ft).abs() > 1e-6 * ft) {
+        bail!("{} runs at {:.3} fps but {} at {:.3} fps: give {what} of one frame rate", c.name, 1.0 / c.motion.frame_time, first.name, 1.0 / ft);
+    }
+    Ok(clips)
+}
+
 /// Read motions from BVH files and NPY feature files (recognised by content), in input order.
 /// NPY inputs need `options.skeleton`; a batch `[n, frames, joints, dims]` gives n motions.
 /// AnyTop features (13 dims) decode with the skeleton's AnyTop record and each clip at the rest

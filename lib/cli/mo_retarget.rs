@@ -7,7 +7,7 @@ use crate::binding::auto::{self, AutoOptions, Body};
 use crate::binding::{Binding, JointMap};
 use crate::bvh;
 use crate::cli::bounds;
-use crate::cli::load::{expand_inputs, is_dash};
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, BvhClip};
 use crate::cli::CommonOpts;
 use crate::document::AnyTopSection;
 use crate::io::{self, npy};
@@ -15,7 +15,6 @@ use crate::motion::Motion;
 use crate::repr::anytop::AnyTopOptions;
 use crate::repr::m2m;
 use crate::retarget::{self, BoundRotation, Repr, RootMotion, Settings};
-use crate::skeleton::Skeleton;
 use anyhow::{bail, Context};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -219,32 +218,10 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
-/// One read clip.
-struct Clip {
-    name: String,
-    skeleton: Skeleton,
-    motion: Motion,
-}
+type Clip = BvhClip;
 
 fn read_clip(path: &Path) -> anyhow::Result<Clip> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-    if npy::looks_like_npy(path, &bytes) {
-        bail!("{name}: mo-retarget reads BVH files (decode features first: mo-encode --decode)");
-    }
-    let parsed = bvh::parse_bytes(&bytes, &name)?;
-    let skeleton = Skeleton::from_bvh(&parsed);
-    skeleton.validate().with_context(|| name.clone())?;
-    let motion = Motion::from_bvh(&parsed, &skeleton);
-    Ok(Clip { name, skeleton, motion })
-}
-
-/// Same tree and names (the examples must be clips of one skeleton).
-fn same_skeleton(a: &Clip, b: &Clip) -> anyhow::Result<()> {
-    match a.skeleton.first_difference(&b.skeleton) {
-        Some(why) => bail!("{} and {} have different skeletons ({why}): all target clips must share one skeleton", a.name, b.name),
-        None => Ok(()),
-    }
+    read_bvh_clip(path, "mo-retarget")
 }
 
 /// The AnyTop rig's natural rest pose: faces +z, so two creatures compare in one frame.
@@ -347,27 +324,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if source.motion.frames < 2 {
         bail!("{}: {} frame(s): a source motion needs at least two frames", source.name, source.motion.frames);
     }
-    let target_files = expand_inputs(&args.targets)?;
-    if target_files.iter().any(|p| is_dash(p)) && is_dash(&args.source) {
+    if args.targets.iter().any(|p| is_dash(p)) && is_dash(&args.source) {
         bail!("stdin ('-') can be read only once");
     }
-    let examples = {
-        use rayon::prelude::*;
-        target_files.par_iter().map(|p| read_clip(p)).collect::<anyhow::Result<Vec<Clip>>>()?
-    };
+    let examples = read_example_clips(&args.targets, "mo-retarget", "target clips")?;
     let first = &examples[0];
-    for e in &examples[1..] {
-        same_skeleton(first, e)?;
-    }
     for e in &examples {
         if e.motion.frames < 2 {
             bail!("{}: {} frame(s): example clips need at least two frames", e.name, e.motion.frames);
         }
     }
     let target_fps = 1.0 / first.motion.frame_time;
-    if let Some(e) = examples.iter().find(|e| (e.motion.frame_time - first.motion.frame_time).abs() > 1e-6 * first.motion.frame_time) {
-        bail!("{} runs at {:.3} fps but {} at {:.3} fps: give example clips of one frame rate", e.name, 1.0 / e.motion.frame_time, first.name, target_fps);
-    }
 
     // The binding.
     let (map, binding): (JointMap, Binding) = if bind == "auto" {

@@ -1,4 +1,5 @@
-//! `mo-sample`: generate motion for any skeleton with a trained denoiser.
+//! `mo-sample`: generate motion for any skeleton with a trained denoiser, or from a few example
+//! clips of it without a model (`--examples`, in `mo_sample_examples`).
 
 use crate::bvh;
 use crate::cli::load::read_skeleton;
@@ -24,7 +25,10 @@ EXAMPLES:
     mo-sample examples/data/spider.bvh --model model --frames 30 --steps 5 --bvh 'spider_{i}.bvh'
     mo-sample examples/data/quadruped.bvh --model model --frames 40 --steps 5 --bvh q.bvh
     mo-sample --reference q.bvh --model model --steps 5 --keep-frames 0-9,30-38 --report > ib.npy
-    mo-sample --reference q.bvh --model model --steps 5 --keep-joints '*Thigh/' --bvh legs.bvh";
+    mo-sample --reference q.bvh --model model --steps 5 --keep-joints '*Thigh/' --bvh legs.bvh
+    mo-sample --examples examples/data/dragon.bvh -n 2 --frames 200 --bvh 'gen_{i}.bvh'
+    mo-sample examples/data/crab.bvh --examples examples/data/crab.bvh --seconds 10 > crab.npy
+    mo-sample --examples gen_0.bvh --reference gen_1.bvh --keep-frames 0-29,170-199 > ib.npy";
 
 /// The default `--smooth`: 7 Hz, the lowest whole cutoff at which the post-process keeps real
 /// motion: on the bundled creatures and real clips (dog, chicken, flamingo, monkey, crab, a
@@ -39,7 +43,8 @@ pub const MAX_SAMPLE_FRAMES: u64 = 10_000;
 /// The default `--blend`: half a second (15 frames at 30 fps), the order of a step.
 pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 
-/// Generate motion for a skeleton with a trained diffusion model (AnyTop).
+/// Generate motion for a skeleton with a trained diffusion model (AnyTop), or from a few clips
+/// of it with no model at all (--examples, GenMM).
 ///
 /// SKELETON is a skeleton document (skel-info's JSON, also on stdin) or a BVH file. The model
 /// needs only the skeleton's topology, rest pose and joint names, so skeletons never seen in
@@ -80,10 +85,28 @@ pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 /// number over every frame boundary of the reference clip (median, p95, max) and over the
 /// boundaries inside the generated frames. A seam jump no larger than the reference's p95 is
 /// as continuous as the clip itself.
+///
+/// Example-based generation (--examples CLIPS..., generative motion matching, GenMM, Li et al.
+/// 2023): no model and no training. CLIPS are BVH files or directories of them, all of one
+/// skeleton and frame rate; the output is new motion stitched from their patches, coarse to
+/// fine over a pyramid in time: the coarsest level starts as a seeded random walk through the
+/// clips' coarse patches (jumping between similar places), and every level replaces each patch
+/// (11 frames) by its nearest clip patch and averages the overlaps; the root's turning is kept
+/// as a rate, so stitched stretches turn smoothly. Two 200-frame samples take about 0.1 s. Any
+/// length (default: the longest clip's; --frames, --seconds), -n samples with seeds --seed,
+/// --seed+1, ... (the same seed gives the same bytes); BVH on the clips' skeleton with --bvh,
+/// else NPY [n, frames, joints, 9] of Motion2Motion features (decode with mo-encode --repr m2m
+/// --decode, or read with mo-metrics and mo-render). SKELETON, if given, must be the clips'
+/// skeleton. Editing works as above: --reference (a clip of the same skeleton and frame rate)
+/// with --keep-frames/--keep-joints; the kept part is imposed at every level and is the
+/// reference's exactly in the output, whose default length is the reference's frame count.
+/// --report prints the pyramid levels and match costs as one JSON line on stderr. --model,
+/// --steps, --sampler, --smooth, --blend and --no-plant-feet belong to the diffusion model.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-sample", version, after_long_help = EXAMPLES)]
 pub struct Args {
-    /// Skeleton document or BVH ('-' = stdin) [default: stdin; with --reference: the reference].
+    /// Skeleton document or BVH ('-' = stdin) [default: stdin; with --reference: the reference;
+    /// with --examples: the clips' own].
     #[arg(value_name = "SKELETON")]
     pub skeleton: Option<PathBuf>,
     /// The same as SKELETON, as a named option.
@@ -96,7 +119,8 @@ pub struct Args {
     /// Number of samples.
     #[arg(short = 'n', long = "samples", value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub samples: u64,
-    /// Frames per sample [default: 120; with --reference: the reference's length].
+    /// Frames per sample [default: 120; with --reference: the reference's length; with
+    /// --examples: the longest clip's].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=MAX_SAMPLE_FRAMES), conflicts_with = "seconds")]
     pub frames: Option<u64>,
     /// Length in seconds (at the skeleton's frame rate).
@@ -121,9 +145,14 @@ pub struct Args {
     /// a joint and all its descendants, comma-separated.
     #[arg(long, value_name = "LIST", requires = "reference")]
     pub keep_joints: Option<String>,
-    /// Print seam continuity as one JSON line on stderr (with --reference).
-    #[arg(long, requires = "reference")]
+    /// Print seam continuity as one JSON line on stderr (with --reference), or with --examples
+    /// the synthesis levels and match costs.
+    #[arg(long)]
     pub report: bool,
+    /// Example-based generation, no model (GenMM): clips of the skeleton, BVH files or
+    /// directories of them.
+    #[arg(long, value_name = "CLIPS", num_args = 1.., conflicts_with_all = ["model", "steps", "sampler", "smooth", "blend", "no_plant_feet"])]
+    pub examples: Vec<PathBuf>,
     /// Low-pass the generated frames over time: the cutoff in Hz where motion keeps half its
     /// amplitude (kept frames and joints stay exact; 0 = the model's raw output).
     #[arg(long, value_name = "HZ", default_value_t = DEFAULT_SMOOTH_HZ)]
@@ -156,6 +185,12 @@ pub enum SamplerArg {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
+    if !args.examples.is_empty() {
+        return super::mo_sample_examples::run(args);
+    }
+    if args.report && args.reference.is_none() {
+        bail!("--report needs --reference (seam continuity) or --examples (the synthesis levels)");
+    }
     crate::nn::keep_freed_memory();
     let count = args.samples as usize;
     let outputs: Option<Vec<PathBuf>> = match &args.bvh {

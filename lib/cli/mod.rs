@@ -16,6 +16,7 @@ pub mod mo_metrics;
 pub mod mo_render;
 pub mod mo_retarget;
 pub mod mo_sample;
+pub mod mo_sample_examples;
 pub mod mo_segment;
 pub mod mo_train;
 pub mod skel_aug;

@@ -24,8 +24,6 @@
 //! Frame rates are the caller's business: `resample` brings the source to the examples' rate.
 
 mod features;
-mod nn;
-mod pyramid;
 pub mod settings;
 #[cfg(test)]
 mod tests;
@@ -34,10 +32,11 @@ pub use settings::{BoundRotation, Repr, RootMotion, Settings};
 
 use crate::binding::JointMap;
 use crate::motion::Motion;
+use crate::patch::channels::{self, Channels};
+use crate::patch::{nn, pyramid};
 use crate::repr::m2m;
 use crate::rng::{stream_seed, PolarGaussian};
 use crate::skeleton::Skeleton;
-use features::Channels;
 use glam::DQuat;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -258,13 +257,13 @@ impl<'a> Plan<'a> {
             known[f] = 1.0;
         }
 
-        let scale = features::feature_scale(target);
+        let scale = channels::feature_scale(target);
         let ratio = features::size_ratio(source_skeleton, target);
         let points = settings.repr != Repr::Rotation;
         let clips: Vec<(Channels, Channels)> = examples
             .iter()
             .map(|e| {
-                let rot = features::rotation_features(e, scale);
+                let rot = channels::rotation_features(e, scale);
                 if points {
                     (features::point_features(e, target, settings.repr, scale), rot)
                 } else {
@@ -317,7 +316,7 @@ impl<'a> Plan<'a> {
             }
         }
         if settings.root_motion == RootMotion::Source {
-            let root = features::rotation_features(&root_only(source), scale * ratio);
+            let root = channels::rotation_features(&root_only(source), scale * ratio);
             for (c, mask) in [(&mut src_m, &mut mask_m), (&mut src_p, &mut mask_p)] {
                 if c.width == 0 {
                     continue;
@@ -357,9 +356,9 @@ impl<'a> Plan<'a> {
         }
         let levels = pyramid::output_levels(frames, longest, patch, settings.coarse_patches, settings.pyramid);
         let root_start = match settings.root_motion {
-            RootMotion::Examples => features::root_start(&examples[0]),
+            RootMotion::Examples => channels::root_start(&examples[0]),
             RootMotion::Source => {
-                let (x, z) = features::root_start(source);
+                let (x, z) = channels::root_start(source);
                 (x * ratio, z * ratio)
             }
         };
@@ -482,7 +481,7 @@ impl<'a> Plan<'a> {
 
         let decode_start = Instant::now();
         let rot = if state_p.width > 0 { &state_p } else { &state_m };
-        let motion = features::decode(rot, self.target, self.scale, self.root_start, self.frame_time)?;
+        let motion = channels::decode(rot, self.target, self.scale, self.root_start, self.frame_time)?;
         report.timings = Timings { prepare, synthesis, decode: decode_start.elapsed(), total: prepare + start.elapsed() };
         Ok(Retargeted { motion, report })
     }

@@ -20,6 +20,7 @@ mod mo_metrics_cli;
 mod mo_render_cli;
 mod mo_retarget_cli;
 mod mo_sample_edit;
+mod mo_sample_examples;
 mod mo_segment_cli;
 mod mo_train_cli;
 mod mo_train_sample_cli;

@@ -1,4 +1,5 @@
-//! Patch nearest neighbours and blending: one matching-and-blending step of Motion2Motion.
+//! Patch nearest neighbours and blending: one matching-and-blending step of GenMM and
+//! Motion2Motion.
 //!
 //! A patch is `patch` consecutive frames of channel vectors; its distance to an example patch
 //! is the mean squared difference of the weighted values (docs/reference/motion2motion.md §3.4).
@@ -12,7 +13,7 @@
 //! tile, rayon over the blocks. Every value is computed by the same code in the same order
 //! whatever the thread count, so results are bit-identical for any number of threads.
 
-use super::features::Channels;
+use super::channels::Channels;
 use rayon::prelude::*;
 
 /// Query patches per parallel block. The Gram rows of a block overlap the next block's by
@@ -373,8 +374,8 @@ fn nearest(row: &[f32], norm: &[f32]) -> (usize, f32) {
 }
 
 /// Average of the chosen example patches over the frames they cover (`choice[i]` = clip and
-/// first frame of the patch placed at frame i).
-fn blend(choice: &[(usize, usize)], clips: &[Channels], frames: usize, p: usize) -> Channels {
+/// first frame of the patch placed at frame i; `frames - p + 1` of them).
+pub(crate) fn blend(choice: &[(usize, usize)], clips: &[Channels], frames: usize, p: usize) -> Channels {
     let width = clips.first().map(|c| c.width).unwrap_or(0);
     let mut out = Channels::zeros(frames, width);
     if width == 0 {

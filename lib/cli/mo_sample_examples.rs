@@ -1,0 +1,184 @@
+//! `mo-sample --examples CLIPS...`: example-based generation without a model (GenMM). This file
+//! reads the clips (and the optional SKELETON and `--reference`), turns the options into
+//! `genmm::Settings` and a `genmm::Keep`, runs `genmm::generate` (one seed per sample), and
+//! writes BVH on the examples' skeleton or Motion2Motion features, all outputs or none.
+
+use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
+use crate::bvh;
+use crate::cli::bounds;
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton, BvhClip};
+use crate::diffusion::edit;
+use crate::genmm::{self, Keep, Settings};
+use crate::io::{self, npy};
+use crate::repr::m2m;
+use anyhow::{bail, Context};
+use std::path::PathBuf;
+use std::time::Instant;
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let count = args.samples as usize;
+    let outputs: Option<Vec<PathBuf>> = match &args.bvh {
+        Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
+        None => None,
+    };
+    let skeleton_path = args.skeleton.as_ref().or(args.skeleton_option.as_ref());
+    let dashes = args.examples.iter().chain(skeleton_path).chain(args.reference.as_ref()).filter(|p| is_dash(p)).count();
+    if dashes > 1 {
+        bail!("stdin ('-') can be read only once");
+    }
+    if args.reference.is_some() && args.keep_frames.is_none() && args.keep_joints.is_none() {
+        bail!("--reference needs --keep-frames RANGES or --keep-joints LIST (what to keep of it)");
+    }
+    let clips = read_example_clips(&args.examples, "mo-sample --examples", "example clips")?;
+    let first = &clips[0];
+    let skeleton = &first.skeleton;
+    if let Some(path) = skeleton_path {
+        let given = read_skeleton(path)?;
+        if let Some(why) = given.skeleton.first_difference(skeleton) {
+            bail!("{} is not the skeleton of the example clips ({}): {why}", given.name, first.name);
+        }
+    }
+    let frame_time = first.motion.frame_time;
+    let fps = if frame_time > 0.0 { 1.0 / frame_time } else { 30.0 };
+    let reference = match &args.reference {
+        Some(path) => Some(read_reference(path, first)?),
+        None => None,
+    };
+    let frames = match (args.seconds, args.frames, &reference) {
+        (Some(s), _, _) => match bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
+            n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
+            n => n,
+        },
+        (None, Some(n), _) => n as usize,
+        (None, None, Some(r)) => r.motion.frames,
+        (None, None, None) => clips.iter().map(|c| c.motion.frames).max().unwrap_or(1),
+    };
+    crate::budget::check_motion(&format!("{count} samples of {frames} frames"), count.saturating_mul(frames), skeleton.len())?;
+    let keep = match &reference {
+        Some(r) => Some(keep(args, r, frames)?),
+        None => None,
+    };
+
+    let motions: Vec<crate::motion::Motion> = clips.iter().map(|c| c.motion.clone()).collect();
+    let settings = Settings { frames: Some(frames), ..Settings::default() };
+    let seeds: Vec<u64> = (0..count as u64).map(|i| args.common.seed.wrapping_add(i)).collect();
+    let generated_at = Instant::now();
+    let generated = genmm::generate(&motions, skeleton, &settings, keep.as_ref(), &seeds).with_context(|| format!("generating from {}", first.name))?;
+    let generation = generated_at.elapsed();
+
+    if args.report {
+        eprintln!("{}", report(&clips, &generated, generation));
+    }
+    if args.common.verbose {
+        eprintln!("mo-sample: {count} x {frames} frames from {} example clip(s) in {:.3} s", clips.len(), generation.as_secs_f64());
+    }
+    if !args.common.quiet {
+        let mut notes: Vec<&String> = generated.iter().flat_map(|g| &g.report.notes).collect();
+        notes.dedup();
+        notes.sort();
+        notes.dedup();
+        for note in notes {
+            eprintln!("mo-sample: note: {note}");
+        }
+    }
+
+    match outputs {
+        Some(paths) => {
+            let texts: Vec<String> = generated.iter().map(|g| bvh::write_string(&g.motion.to_bvh(skeleton))).collect();
+            // All samples or none.
+            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_bytes())).collect::<Vec<_>>())?;
+        }
+        None => {
+            io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
+            let features: Vec<_> = generated.iter().map(|g| m2m::encode(&g.motion)).collect();
+            let shape = [count, frames, skeleton.len(), m2m::DIMS];
+            let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
+            let mut bytes = Vec::new();
+            npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
+            io::write_output(args.common.output.as_deref(), &bytes)?;
+        }
+    }
+    if args.common.verbose {
+        eprintln!("mo-sample: total {:.3} s", started.elapsed().as_secs_f64());
+    }
+    Ok(())
+}
+
+/// `--reference`: a clip of the examples' skeleton at their frame rate.
+fn read_reference(path: &std::path::Path, first: &BvhClip) -> anyhow::Result<BvhClip> {
+    let r = read_bvh_clip(path, "mo-sample --reference")?;
+    if let Some(why) = first.skeleton.first_difference(&r.skeleton) {
+        bail!("the reference {} is not on the skeleton of the example clips ({}): {why}", r.name, first.name);
+    }
+    let (a, b) = (r.motion.frame_time, first.motion.frame_time);
+    if (a - b).abs() > 1e-6 * b {
+        bail!(
+            "the reference {} runs at {:.3} fps but the example clips ({}) at {:.3} fps: give a reference of their frame rate",
+            r.name,
+            1.0 / a,
+            first.name,
+            1.0 / b
+        );
+    }
+    if r.motion.frames == 0 {
+        bail!("the reference {} has no frames", r.name);
+    }
+    Ok(r)
+}
+
+/// What `--keep-frames` and `--keep-joints` keep: frames must exist in both the output and the
+/// reference; joints are kept over every output frame the reference has.
+fn keep<'a>(args: &Args, r: &'a BvhClip, frames: usize) -> anyhow::Result<Keep<'a>> {
+    let known = frames.min(r.motion.frames);
+    let mut kept_frames = vec![false; frames];
+    if let Some(text) = &args.keep_frames {
+        let why = format!("the output has {frames} frames, the reference {} has {}", r.name, r.motion.frames);
+        for range in edit::parse_frame_ranges(text, known, &why).context("--keep-frames")? {
+            kept_frames[range].iter_mut().for_each(|k| *k = true);
+        }
+    }
+    let mut joints = vec![false; r.skeleton.len()];
+    if let Some(list) = &args.keep_joints {
+        for j in edit::select_joints(&r.skeleton, list).context("--keep-joints")? {
+            joints[j] = true;
+        }
+    }
+    let every_frame = kept_frames.iter().all(|&k| k);
+    let every_joint = known == frames && joints.iter().all(|&k| k);
+    if every_frame || every_joint {
+        bail!("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate");
+    }
+    Ok(Keep { reference: &r.motion, frames: kept_frames, joints })
+}
+
+/// `--report`: the synthesis of every sample, one JSON line.
+fn report(clips: &[BvhClip], generated: &[genmm::Generated], time: std::time::Duration) -> String {
+    let samples: Vec<serde_json::Value> = generated
+        .iter()
+        .map(|g| {
+            let levels: Vec<serde_json::Value> = g
+                .report
+                .levels
+                .iter()
+                .map(|l| serde_json::json!({ "frames": l.frames, "example_patches": l.example_patches, "match_costs": l.step_costs }))
+                .collect();
+            serde_json::json!({
+                "seed": g.report.seed,
+                "frames": g.report.frames,
+                "patch": g.report.patch,
+                "levels": levels,
+                "synthesis_ms": g.report.synthesis.as_secs_f64() * 1e3,
+                "notes": g.report.notes,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "report": "genmm",
+        "examples": clips.iter().map(|c| &c.name).collect::<Vec<_>>(),
+        "example_frames": clips.iter().map(|c| c.motion.frames).sum::<usize>(),
+        "generation_ms": time.as_secs_f64() * 1e3,
+        "samples": samples,
+    })
+    .to_string()
+}
