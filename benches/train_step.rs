@@ -125,7 +125,7 @@ fn main() {
         lambda_geo: 1.0,
         lambda_vel: 0.0,
         ema: 0.999,
-        noise_shift: 1.0,
+        noise_shift: None,
         augment: 0.0,
         augment_variants: 0,
     };

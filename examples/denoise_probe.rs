@@ -59,8 +59,7 @@ fn main() -> anyhow::Result<()> {
             let (a, b) = schedule.noise_coefficients(t);
             let noise = menagerie::rng::gaussian(&mut rng, clean.data.len());
             let noisy = Features { data: clean.data.iter().zip(&noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() };
-            let item =
-                BatchItem { features: &noisy, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 };
+            let item = BatchItem { features: &noisy, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 };
             let batch = batch_from(&[item], &[t as u32], &device)?;
             let pred = loaded.model.forward(&batch)?;
             let frames = clean.frames;
@@ -110,8 +109,7 @@ fn sensitivity(
             let noisy_with =
                 |noise: &[f32]| Features { data: clean.data.iter().zip(noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() };
             let predict = |f: &Features| -> anyhow::Result<Vec<f32>> {
-                let item =
-                    BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: c.start as u32 };
+                let item = BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 };
                 let batch = batch_from(&[item], &[t as u32], device)?;
                 Ok(model.forward(&batch)?.narrow(1, 1, f.frames)?.contiguous()?.flatten_all()?.to_vec1()?)
             };

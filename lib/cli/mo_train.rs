@@ -117,9 +117,10 @@ pub struct Args {
     /// anytop: divide the cosine noise schedule's signal-to-noise ratio by S² at every step, so
     /// the slow, whole-crop directions of motion are drowned in noise early enough for sampling
     /// to choose a motion over many steps instead of settling on the mean pose in the first.
-    /// 1 = AnyTop's schedule. A new run only: a resumed run keeps its checkpoint's.
-    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = bounds::positive(crate::diffusion::checkpoint::MAX_NOISE_SHIFT))]
-    pub noise_shift: f64,
+    /// 1 = AnyTop's schedule [default: 1 for a new run; a resumed run keeps its checkpoint's,
+    /// unless this is given: then the model goes on learning under the new schedule].
+    #[arg(long, value_name = "S", value_parser = bounds::positive(crate::diffusion::checkpoint::MAX_NOISE_SHIFT))]
+    pub noise_shift: Option<f64>,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
@@ -246,8 +247,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             bail!("{flag} must be a weight >= 0, found {w}");
         }
     }
-    if args.noise_shift < 1.0 {
-        bail!("--noise-shift must be at least 1 (1 = AnyTop's schedule), found {}", args.noise_shift);
+    if let Some(shift) = args.noise_shift.filter(|&s| s < 1.0) {
+        bail!("--noise-shift must be at least 1 (1 = AnyTop's schedule), found {shift}");
     }
     let device = Device::Cpu;
     let done = match args.arch {
@@ -271,6 +272,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let (seed, dmax) = resume.as_ref().map_or((opts.seed, topology::DEFAULT_DMAX), |r| (r.info().seed, r.info().dmax));
             if resume.as_ref().is_some_and(|r| r.differs(&opts)) {
                 say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
+            }
+            if let Some((old, new)) = resume.as_ref().and_then(|r| r.shift_changes(&opts)) {
+                say(args, &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
             }
             refuse_to_overwrite(args)?;
             let set = training_set(args, seed, dmax)?;

@@ -228,9 +228,9 @@ pub struct AnyTopOptions {
     /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
     /// 0 = none.
     pub ema: f64,
-    /// The noise schedule's shift for a new run (`Schedule::cosine_shifted`; a resumed run
-    /// keeps its checkpoint's).
-    pub noise_shift: f64,
+    /// The noise schedule's shift (`Schedule::cosine_shifted`): none = 1 for a new run, the
+    /// checkpoint's for a resumed one; given, a resumed run continues under the new schedule.
+    pub noise_shift: Option<f64>,
 }
 
 /// A denoiser checkpoint to continue, with its optimiser state.
@@ -261,6 +261,11 @@ impl AnyTopResume {
     pub fn differs(&self, opts: &AnyTopOptions) -> bool {
         let i = &self.loaded.info;
         i.batch != opts.batch || i.crop != opts.crop || i.seed != opts.seed || i.augment != opts.augment || i.augment_variants != opts.augment_variants
+    }
+
+    /// The noise shift the checkpoint was trained with, when `opts` asks for another.
+    pub fn shift_changes(&self, opts: &AnyTopOptions) -> Option<(f64, f64)> {
+        opts.noise_shift.filter(|&s| s != self.loaded.info.noise_shift).map(|s| (self.loaded.info.noise_shift, s))
     }
 }
 
@@ -307,12 +312,15 @@ impl AnyTopTrainer {
                     augment: 0.0,
                     augment_variants: 0,
                     ema: 0.0,
-                    noise_shift: opts.noise_shift,
+                    noise_shift: 1.0,
                     skeletons: Vec::new(),
                 };
                 (varmap, model, AdamW::new(opts.lr), info, Default::default())
             }
         };
+        if let Some(shift) = opts.noise_shift {
+            info.noise_shift = shift;
+        }
         let schedule = info.schedule();
         info.augment = opts.augment;
         info.augment_variants = opts.augment_variants;

@@ -4,7 +4,8 @@
 //! 1. Enrichment: each joint token is projected to `width` by its own linear (root and other
 //!    joints separately, the rest-pose token P_S at t = 0 separately from motion frames); the
 //!    projected joint-name embedding is added to every token of that joint; a sinusoidal
-//!    temporal position is added per token (0 for P_S, k + 1 + crop start for frame k).
+//!    temporal position is added per token (0 for P_S, k + 1 + `BatchItem::start` for frame k;
+//!    training and sampling both give start 0, the reference gives training crops their start).
 //! 2. `layers` skeletal-temporal layers, post-norm as the reference:
 //!    `x += W_t·temb` (per-layer linear of the sinusoidal step embedding — the reference has no
 //!    other timestep MLP); `x = LN1(x + SkeletalAttn(x))` over the joints of each frame with the

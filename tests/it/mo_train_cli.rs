@@ -162,3 +162,33 @@ fn the_saved_model_is_the_moving_average_of_the_weights() {
         assert_eq!(flat(w), flat(&raw_avg[&format!("w.{name}")]), "{name}");
     }
 }
+
+/// `--noise-shift` is recorded, a resumed run keeps it unless it is given again (then the
+/// model goes on under the new schedule and says so), and a shift below 1 is refused.
+#[test]
+fn the_noise_shift_is_recorded_and_kept_on_resume() {
+    let dir = tempdir("train-shift");
+    let data = data(&dir);
+    let out = dir.join("model");
+    let mut args = train_args(&data, &out, "2");
+    args.extend(["--noise-shift", "4"]);
+    ok(&run("mo-train", &args, None), "shift 4");
+    assert_eq!(info(&out)["noise_shift"].as_f64(), Some(4.0));
+    let mut args = train_args(&data, &out, "3");
+    args.push("--resume");
+    ok(&run("mo-train", &args, None), "resume");
+    assert_eq!(info(&out)["noise_shift"].as_f64(), Some(4.0));
+    let mut args = train_args(&data, &out, "4");
+    args.extend(["--resume", "--noise-shift", "8"]);
+    let changed = run("mo-train", &args, None);
+    ok(&changed, "resume with another shift");
+    assert!(String::from_utf8_lossy(&changed.stderr).contains("--noise-shift 4"), "no note about the change");
+    assert_eq!(info(&out)["noise_shift"].as_f64(), Some(8.0));
+    // The sampler reads the schedule from the checkpoint.
+    let sample = run("mo-sample", &[s(&data[0].join("biped_walk.bvh")), "--model", s(&out), "--frames", "8", "--steps", "3"], None);
+    ok(&sample, "sample");
+    let mut args = train_args(&data, &dir.join("other"), "1");
+    args.extend(["--noise-shift", "0.5"]);
+    common::check_failure("mo-train", "shift 0.5", &run("mo-train", &args, None), "--noise-shift");
+    assert!(!dir.join("other").join("checkpoint.json").exists());
+}
