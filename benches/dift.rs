@@ -19,7 +19,6 @@ use candle_core::Device;
 use menagerie::augment::{self, RemoveAmount};
 use menagerie::bvh;
 use menagerie::diffusion::checkpoint::{self, Frozen};
-use menagerie::diffusion::Schedule;
 use menagerie::dift::correspond::{self, best_matches, cosine_matrix};
 use menagerie::dift::eval::{self, Accuracy};
 use menagerie::dift::{self, DiftOptions};

@@ -17,7 +17,7 @@ use menagerie::cli::load::read_skeleton;
 use menagerie::diffusion::condition::SkeletonCondition;
 use menagerie::diffusion::edit::{boundary_jumps, jump_distribution, jump_distribution_of, sample_edit, seam_jump, KeepMask};
 use menagerie::diffusion::sample::{sample, SampleOptions};
-use menagerie::diffusion::{checkpoint, Sampler, Schedule};
+use menagerie::diffusion::{checkpoint, Sampler};
 use menagerie::repr::smooth::{lambda_for_cutoff, smooth_features};
 use menagerie::repr::Features;
 use std::path::PathBuf;

@@ -187,8 +187,9 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     // The sampler reads the schedule from the checkpoint.
     let sample = run("mo-sample", &[s(&data[0].join("biped_walk.bvh")), "--model", s(&out), "--frames", "8", "--steps", "3"], None);
     ok(&sample, "sample");
-    let mut args = train_args(&data, &dir.join("other"), "1");
+    let other = dir.join("other");
+    let mut args = train_args(&data, &other, "1");
     args.extend(["--noise-shift", "0.5"]);
     common::check_failure("mo-train", "shift 0.5", &run("mo-train", &args, None), "--noise-shift");
-    assert!(!dir.join("other").join("checkpoint.json").exists());
+    assert!(!other.join("checkpoint.json").exists());
 }
