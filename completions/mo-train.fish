@@ -15,6 +15,7 @@ complete -c mo-train -l lambda-vel -d 'Weight of a velocity loss next to the MSE
 complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3' -r
 complete -c mo-train -l augment-variants -d 'Augmented variants prepared per skeleton (alternately removing and adding joints)' -r
 complete -c mo-train -l ema -d 'anytop: decay of the moving average of the weights that the saved model holds and mo-sample samples with (the raw weights are kept beside it for --resume). 0 = save the raw weights. An average over about 1/(1 - decay) steps' -r
+complete -c mo-train -l noise-shift -d 'anytop: divide the cosine noise schedule\'s signal-to-noise ratio by S² at every step, so the slow, whole-crop directions of motion are drowned in noise early enough for sampling to choose a motion over many steps instead of settling on the mean pose in the first. 1 = AnyTop\'s schedule [default: 10 for a new run (3-skeleton proxy: samples\' motion energy 0.2 of the clips\' at 1, 0.4-0.6 at 10); a resumed run keeps its checkpoint\'s, unless this is given: then the model goes on learning under the new schedule]' -r
 complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this often' -r
 complete -c mo-train -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-train -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
