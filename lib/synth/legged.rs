@@ -22,38 +22,57 @@ pub(super) struct BipedBody {
     pub legs: Vec<(Leg, usize, f64)>,
 }
 
-/// The Mixamo-named human body scaled by `shape` (all factors 1 give the example biped).
-pub(super) fn biped_body(shape: &Proportions) -> BipedBody {
+/// The Mixamo-named human body scaled by `shape` (all factors 1 give the example biped), named
+/// and given fingers as `rig` says.
+pub(super) fn biped_body(shape: &Proportions, rig: &Rig) -> BipedBody {
+    use super::rig::HumanPart as H;
     let layout = Layout { root_order: "ZXY", joint_order: "ZXY", all_positions: false };
-    let m = |n: &str| format!("mixamorig:{n}");
+    let m = |part: H, left: Option<bool>| human_name(rig.naming, part, left);
     let k = shape.size;
     let (arm_k, leg_k, neck_k) = (k * shape.limbs, k * shape.limbs, k * shape.neck);
     // Pelvis height follows the legs: hip drop and ankle scale with the body, the legs (0.84)
     // with the limbs.
-    let mut b = Builder::new(&m("Hips"), v3(0.0, 0.98 * k + 0.84 * (leg_k - k), 0.0), layout);
-    let spine = b.add(&m("Spine"), 0, v3(0.0, 0.1 * k, 0.0));
-    let spine1 = b.add(&m("Spine1"), spine, v3(0.0, 0.12 * k, 0.0));
-    let spine2 = b.add(&m("Spine2"), spine1, v3(0.0, 0.13 * k, 0.0));
-    let neck = b.add(&m("Neck"), spine2, v3(0.0, 0.14 * k, 0.01 * k));
-    let head = b.add(&m("Head"), neck, v3(0.0, 0.09 * neck_k, 0.01 * neck_k));
+    let mut b = Builder::new(&m(H::Hips, None), v3(0.0, 0.98 * k + 0.84 * (leg_k - k), 0.0), layout);
+    let spine = b.add(&m(H::Spine(0), None), 0, v3(0.0, 0.1 * k, 0.0));
+    let spine1 = b.add(&m(H::Spine(1), None), spine, v3(0.0, 0.12 * k, 0.0));
+    let spine2 = b.add(&m(H::Spine(2), None), spine1, v3(0.0, 0.13 * k, 0.0));
+    let neck = b.add(&m(H::Neck, None), spine2, v3(0.0, 0.14 * k, 0.01 * k));
+    let head = b.add(&m(H::Head, None), neck, v3(0.0, 0.09 * neck_k, 0.01 * neck_k));
     b.end(head, v3(0.0, 0.18 * k, 0.0));
     let mut arms = Vec::new();
     for left in [true, false] {
-        let (s, side) = if left { (1.0, "Left") } else { (-1.0, "Right") };
-        let sh = b.add(&m(&format!("{side}Shoulder")), spine2, v3(0.06 * s * k, 0.1 * k, 0.0));
-        let arm = b.add(&m(&format!("{side}Arm")), sh, v3(0.12 * s * k, 0.0, 0.0));
-        let fore = b.add(&m(&format!("{side}ForeArm")), arm, v3(0.27 * s * arm_k, 0.0, 0.0));
-        let hand = b.add(&m(&format!("{side}Hand")), fore, v3(0.25 * s * arm_k, 0.0, 0.0));
-        b.end(hand, v3(0.18 * s * k, 0.0, 0.0));
+        let s = if left { 1.0 } else { -1.0 };
+        let side = Some(left);
+        let sh = b.add(&m(H::Shoulder, side), spine2, v3(0.06 * s * k, 0.1 * k, 0.0));
+        let arm = b.add(&m(H::Arm, side), sh, v3(0.12 * s * k, 0.0, 0.0));
+        let fore = b.add(&m(H::ForeArm, side), arm, v3(0.27 * s * arm_k, 0.0, 0.0));
+        let hand = b.add(&m(H::Hand, side), fore, v3(0.25 * s * arm_k, 0.0, 0.0));
+        if rig.fingers == 0 {
+            b.end(hand, v3(0.18 * s * k, 0.0, 0.0));
+        }
+        // Fingers fan out from the palm along the hand's axis; the thumb sits forward and lower.
+        // Five fingers are thumb..pinky, three are thumb, index and middle.
+        for f in 0..rig.fingers {
+            let (base, step) = if f == 0 {
+                (v3(0.03 * s * k, -0.01 * k, 0.03 * k), v3(0.03 * s * arm_k, 0.0, 0.015 * arm_k))
+            } else {
+                let z = 0.022 * k - 0.012 * k * (f - 1) as f64;
+                (v3(0.09 * s * k, 0.0, z), v3(0.028 * s * arm_k, 0.0, 0.0))
+            };
+            let names: Vec<String> = (0..3).map(|i| m(H::Finger(f, i), side)).collect();
+            let joints = b.chain(&names, hand, base, step);
+            b.end(joints[2], step * 0.8);
+        }
         arms.push((arm, fore, hand));
     }
     let mut legs = Vec::new();
     for left in [true, false] {
-        let (s, side) = if left { (1.0, "Left") } else { (-1.0, "Right") };
-        let up = b.add(&m(&format!("{side}UpLeg")), 0, v3(0.09 * s * k, -0.06 * k, 0.0));
-        let knee = b.add(&m(&format!("{side}Leg")), up, v3(0.0, -0.43 * leg_k, 0.0));
-        let foot = b.add(&m(&format!("{side}Foot")), knee, v3(0.0, -0.41 * leg_k, 0.0));
-        let toe = b.add(&m(&format!("{side}ToeBase")), foot, v3(0.0, -0.06 * k, 0.12 * k));
+        let s = if left { 1.0 } else { -1.0 };
+        let side = Some(left);
+        let up = b.add(&m(H::UpLeg, side), 0, v3(0.09 * s * k, -0.06 * k, 0.0));
+        let knee = b.add(&m(H::Leg, side), up, v3(0.0, -0.43 * leg_k, 0.0));
+        let foot = b.add(&m(H::Foot, side), knee, v3(0.0, -0.41 * leg_k, 0.0));
+        let toe = b.add(&m(H::Toe, side), foot, v3(0.0, -0.06 * k, 0.12 * k));
         b.end(toe, v3(0.0, -0.02 * k, 0.06 * k));
         legs.push((Leg { upper: up, lower: knee, tip: Some(foot), rest_pole: DVec3::Z }, toe, 0.09 * s * k));
     }
@@ -62,7 +81,7 @@ pub(super) fn biped_body(shape: &Proportions) -> BipedBody {
 
 /// Mixamo-named human walking: alternating legs, counter-swinging arms, a level head.
 pub(super) fn biped(rng: &mut SplitMix64) -> (Skeleton, Motion) {
-    let body = biped_body(&training::proportions("biped", 0).expect("biped exists"));
+    let body = biped_body(&training::proportions("biped", 0).expect("biped exists"), &Rig::NATIVE);
     let BipedBody { skel, spine: [spine, spine1, spine2], neck, head, arms, legs } = body;
 
     let (frames, period) = frames_for(rng.vary(1.1, 0.06), 3);
@@ -147,6 +166,8 @@ enum Part {
     Forefoot,
     Foretoe,
     Wing(usize),
+    Jaw,
+    Ear,
 }
 
 struct QuadSpec {
@@ -163,6 +184,8 @@ struct QuadSpec {
     neck_length: f64,
     tail: usize,
     wings: bool,
+    /// A jaw and two ears on the head.
+    jaw_and_ears: bool,
     /// Touchdown phases of left hind, left fore, right hind, right fore.
     touchdown: [f64; 4],
     gait: Gait,
@@ -195,6 +218,28 @@ fn bip01_name(part: Part, left: Option<bool>) -> String {
         Part::Forefoot => format!("Bip01_{s}Forefoot"),
         Part::Foretoe => format!("Bip01_{s}Finger0"),
         Part::Wing(i) => format!("Bip01_{s}Wing{i}"),
+        Part::Jaw => "BN_Jaw_01".into(),
+        Part::Ear => format!("BN_Ear_{}01", s),
+    }
+}
+
+/// 3ds Max Biped set up as a quadruped: hind legs have the fourth link (`Bip01_L_HorseLink`)
+/// between calf and foot, the front legs are arms, extra bones are `BN_` (`BN_Tail_01`).
+fn horselink_name(part: Part, left: Option<bool>) -> String {
+    let s = match left {
+        Some(true) => "L_",
+        Some(false) => "R_",
+        None => "",
+    };
+    match part {
+        Part::Foot => format!("Bip01_{s}HorseLink"),
+        Part::Toe => format!("Bip01_{s}Foot"),
+        Part::UpperArm => format!("Bip01_{s}UpperArm"),
+        Part::Forearm => format!("Bip01_{s}Forearm"),
+        Part::Forefoot => format!("Bip01_{s}Forefoot"),
+        Part::Foretoe => format!("Bip01_{s}Finger0"),
+        Part::Wing(i) => format!("BN_Wing_{s}{:02}", i + 1),
+        other => bip01_name(other, left),
     }
 }
 
@@ -220,6 +265,8 @@ fn rigify_name(part: Part, left: Option<bool>) -> String {
         Part::Forefoot => format!("DEF-forefoot{s}"),
         Part::Foretoe => format!("DEF-foretoe{s}"),
         Part::Wing(i) => format!("DEF-wing{s}.{:03}", i + 1),
+        Part::Jaw => "DEF-jaw".into(),
+        Part::Ear => format!("DEF-ear{s}"),
     }
 }
 
@@ -241,6 +288,7 @@ pub(super) fn quadruped(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         neck_length: 0.14,
         tail: 4,
         wings: false,
+        jaw_and_ears: false,
         touchdown,
         gait: Gait { period, duty: rng.vary(0.68, 0.03), stride: rng.vary(0.5, 0.08), lift: rng.vary(0.06, 0.1) },
         cycles: 3,
@@ -265,6 +313,7 @@ pub(super) fn dragon(rng: &mut SplitMix64) -> (Skeleton, Motion) {
         neck_length: 0.3,
         tail: 8,
         wings: true,
+        jaw_and_ears: false,
         touchdown: [0.0, 0.5 + pair, 0.5, pair],
         gait: Gait { period, duty: rng.vary(0.55, 0.03), stride: rng.vary(1.3, 0.08), lift: rng.vary(0.16, 0.1) },
         cycles: 3,
@@ -280,6 +329,9 @@ pub(super) struct QuadBody {
     pub spine: Vec<usize>,
     pub neck: Vec<usize>,
     pub head: usize,
+    /// Jaw and ears (left, right), when the spec asks for them.
+    pub jaw: Option<usize>,
+    pub ears: Vec<usize>,
     pub tail: Vec<usize>,
     /// Three joints per wing, left then right; empty without wings.
     pub wings: Vec<[usize; 3]>,
@@ -317,6 +369,20 @@ fn quad_body(spec: &QuadSpec) -> QuadBody {
     }
     let head = b.add(&name(Part::Head, None), parent, v3(0.0, 0.05 * k, 0.06 * k));
     b.end(head, v3(0.0, -0.02 * k, 0.16 * k));
+    let (mut jaw, mut ears) = (None, Vec::new());
+    if spec.jaw_and_ears {
+        // The jaw hinges under the back of the skull and runs forward under the muzzle; the
+        // ears stand on top of the skull, leaning out and back.
+        let j = b.add(&name(Part::Jaw, None), head, v3(0.0, -0.03 * k, 0.02 * k));
+        b.end(j, v3(0.0, -0.01 * k, 0.13 * k));
+        jaw = Some(j);
+        for left in [true, false] {
+            let s = if left { 1.0 } else { -1.0 };
+            let e = b.add(&name(Part::Ear, Some(left)), head, v3(0.035 * s * k, 0.04 * k, 0.0));
+            b.end(e, v3(0.015 * s * k, 0.05 * k, -0.015 * k));
+            ears.push(e);
+        }
+    }
     // Legs: each is (IK chain, home x, home z, pole). Elbows point back, knees forward.
     let mut legs: Vec<(Leg, f64, f64, DVec3)> = Vec::new();
     let mut add_leg = |b: &mut Builder, parent: usize, left: bool, front: bool| {
@@ -357,7 +423,7 @@ fn quad_body(spec: &QuadSpec) -> QuadBody {
         tail.push(parent);
     }
     b.end(parent, v3(0.0, 0.0, -0.1 * tk));
-    QuadBody { skel: b.build(), spine, neck, head, tail, wings, legs, hip_drop, bone, ankle_y }
+    QuadBody { skel: b.build(), spine, neck, head, jaw, ears, tail, wings, legs, hip_drop, bone, ankle_y }
 }
 
 fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
@@ -410,9 +476,10 @@ fn four_legged(spec: &QuadSpec, rng: &mut SplitMix64) -> (Skeleton, Motion) {
     (skel, motion)
 }
 
-/// The quadruped's or (with `dragon`) the dragon's body scaled by `shape`, for training clips.
-/// Only the body fields of the spec matter here; the gait ones are the training module's.
-pub(super) fn quad_training_body(dragon: bool, shape: &Proportions) -> QuadBody {
+/// The quadruped's or (with `dragon`) the dragon's body scaled by `shape`, named and given a
+/// jaw and ears as `rig` says, for training clips. Only the body fields of the spec matter
+/// here; the gait ones are the training module's.
+pub(super) fn quad_training_body(dragon: bool, shape: &Proportions, rig: &Rig) -> QuadBody {
     let gait = Gait { period: 1.0, duty: 0.5, stride: 1.0, lift: 0.1 };
     let spec = QuadSpec {
         layout: if dragon {
@@ -420,7 +487,11 @@ pub(super) fn quad_training_body(dragon: bool, shape: &Proportions) -> QuadBody 
         } else {
             Layout { root_order: "XYZ", joint_order: "XYZ", all_positions: false }
         },
-        name: if dragon { rigify_name } else { bip01_name },
+        name: match (rig.naming, dragon) {
+            (Naming::Biped, _) => horselink_name,
+            (_, true) => rigify_name,
+            (_, false) => bip01_name,
+        },
         scale: if dragon { 2.4 } else { 1.0 } * shape.size,
         limbs: shape.limbs,
         tail_length: shape.tail,
@@ -429,6 +500,7 @@ pub(super) fn quad_training_body(dragon: bool, shape: &Proportions) -> QuadBody 
         neck_length: if dragon { 0.3 } else { 0.14 } * shape.neck,
         tail: shape.tail_joints,
         wings: dragon,
+        jaw_and_ears: rig.jaw_and_ears,
         touchdown: [0.0; 4],
         gait,
         cycles: 1,

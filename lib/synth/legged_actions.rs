@@ -55,7 +55,7 @@ impl Idle {
 
 pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
     let shape = job.shape;
-    let BipedBody { skel, spine, neck, head, arms, legs } = biped_body(&shape);
+    let BipedBody { skel, spine, neck, head, arms, legs } = biped_body(&shape, &job.rig);
     let (k, r) = (shape.size, shape.size * shape.limbs);
     let leg_len = 0.84 * r;
     let run = job.action == Action::Run;
@@ -154,8 +154,8 @@ pub(super) fn dragon(job: &Job, rng: &mut SplitMix64) -> Clip {
 /// (dragon) half folded and stirring.
 fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
     let shape = job.shape;
-    let body = quad_training_body(dragon, &shape);
-    let QuadBody { skel, spine, neck, head, tail, wings, legs, hip_drop, bone, ankle_y } = body;
+    let body = quad_training_body(dragon, &shape, &job.rig);
+    let QuadBody { skel, spine, neck, head, jaw, ears, tail, wings, legs, hip_drop, bone, ankle_y } = body;
     let k = if dragon { 2.4 } else { 1.0 } * shape.size;
     let r = k * shape.limbs;
     let trot = job.action == Action::Run;
@@ -207,6 +207,17 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
             p.local(j, ry(0.6 * look / n_neck) * rx(nod * a * wave(2.0 * c - 0.1 * i as f64) + 4.0 * rest / n_neck));
         }
         p.local(head, ry(0.4 * look) * rx(-3.0 * rest * wave(t / 5.0)));
+        // The mouth pants while moving and opens now and then standing; the ears turn with
+        // the look and flick on their own slow rhythm.
+        if let Some(jaw) = jaw {
+            let pant = 6.0 * a * (0.5 + 0.5 * wave(2.0 * c)) + 10.0 * rest * smoothstep(wave(t / 4.3 + 0.2));
+            p.local(jaw, rx(2.0 + pant));
+        }
+        for (side, &e) in ears.iter().enumerate() {
+            let flick = 15.0 * smoothstep(2.0 * wave(t / 2.7 + 0.37 * side as f64) - 1.0);
+            let q = ry(0.3 * look) * rz(-flick) * rx(-5.0 * a);
+            p.local(e, if side == 0 { q } else { mirror(q) });
+        }
         // Walking, the tail lags the hips; standing, it swishes on its own slower rhythm.
         let n_tail = tail.len() as f64;
         for (i, &j) in tail.iter().enumerate() {

@@ -27,12 +27,17 @@ mod bird;
 mod body_actions;
 mod legged;
 mod legged_actions;
+mod rig;
 mod route;
 mod training;
 mod undulating;
 
+pub(crate) use rig::human_name;
+pub use rig::{rig, Naming, Rig, UpAxis, RIG_VARIANTS};
 pub use training::{actions, proportions, training_clip, write_training_zoo, Action, Clip, Proportions, CLIP_FRAMES};
 
+#[cfg(test)]
+mod rig_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -106,7 +106,10 @@ pub fn proportions(name: &str, variant: u64) -> Option<Proportions> {
     if !creature_names().contains(&name) {
         return None;
     }
-    let (base, ranges) = counts(name);
+    let (base, mut ranges) = counts(name);
+    if variant >= rig::RIG_VARIANTS {
+        ranges = rig::wide_counts(name).unwrap_or(ranges);
+    }
     if variant == 0 {
         let [body_joints, neck_joints, tail_joints] = base;
         return Some(Proportions { size: 1.0, limbs: 1.0, neck: 1.0, tail: 1.0, body_joints, neck_joints, tail_joints });
@@ -137,6 +140,14 @@ pub const CLIP_FRAMES: std::ops::RangeInclusive<usize> = 30..=3000;
 /// `None` for an unknown creature or an action it does not perform (see `actions`). Frame
 /// counts outside `CLIP_FRAMES` are clamped into it.
 pub fn training_clip(name: &str, variant: u64, action: Action, seed: u64, frames: usize) -> Option<Clip> {
+    let (mut clip, rig) = native_clip(name, variant, action, seed, frames)?;
+    rig::apply(&rig, &mut clip);
+    Some(clip)
+}
+
+/// `training_clip` before its axes, units and root are converted to the variant's rig (names
+/// and anatomy are already the rig's): Y-up metres, root OFFSET at the hips.
+pub(crate) fn native_clip(name: &str, variant: u64, action: Action, seed: u64, frames: usize) -> Option<(Clip, Rig)> {
     if !actions(name).contains(&action) {
         return None;
     }
@@ -144,7 +155,8 @@ pub fn training_clip(name: &str, variant: u64, action: Action, seed: u64, frames
     let frames = frames.clamp(*CLIP_FRAMES.start(), *CLIP_FRAMES.end());
     // Name, action and variant all mix in, so clips are independent of each other.
     let mut rng = SplitMix64::new(seed ^ fnv1a(name) ^ fnv1a(action.name()).rotate_left(17) ^ variant.rotate_left(40));
-    let job = Job { shape, action, frames };
+    let rig = rig::rig(name, variant)?;
+    let job = Job { shape, action, frames, rig };
     let clip = match name {
         "biped" => legged_actions::biped(&job, &mut rng),
         "quadruped" => legged_actions::quadruped(&job, &mut rng),
@@ -156,7 +168,7 @@ pub fn training_clip(name: &str, variant: u64, action: Action, seed: u64, frames
         "snake" => body_actions::snake(&job, &mut rng),
         _ => body_actions::fish(&job, &mut rng),
     };
-    Some(clip)
+    Some((clip, rig))
 }
 
 /// Write `clips_per_action` clips of every action of every creature for variants
@@ -201,6 +213,8 @@ pub(crate) struct Job {
     pub shape: Proportions,
     pub action: Action,
     pub frames: usize,
+    /// Naming, anatomy, axes and units (applied after posing, in the native frame).
+    pub rig: Rig,
 }
 
 impl Job {
