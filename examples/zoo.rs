@@ -6,7 +6,10 @@
 //! The default directory is `examples/data` and the default seed `synth::DEFAULT_SEED`; the
 //! same seed always writes byte-identical files. `--training` writes the training zoo instead
 //! (`synth::write_training_zoo`: every action of every creature on variants 0..N, default 8,
-//! N clips per action, default 1) into DIR/<creature>_v<k>/<action>_<n>.bvh.
+//! N clips per action, default 1) into DIR/<creature>_v<k>/<action>_<n>.bvh. Variants from
+//! `synth::RIG_VARIANTS` (8) on also come in the conventions of real files (Mixamo, LAFAN, CMU
+//! and 3ds Max Biped names, Z-up, centimetres, root at the origin, jaws, ears and fingers), so
+//! `--variants 16` adds eight such bodies per creature; 0..8 stay as they always were.
 
 use menagerie::synth;
 use std::path::PathBuf;

@@ -19,7 +19,8 @@
 //! proportions and joint counts and gives each family several actions (walk, run, idle, turn,
 //! walk-stop-walk, ...): `training` holds its API, `route` the ground track and foot planning
 //! that let bodies stop and curve, and `legged_actions`, `arthropod_actions` and `body_actions`
-//! the families' actions.
+//! the families' actions. `rig` gives training variants from `RIG_VARIANTS` on the naming,
+//! axis, unit and root conventions of real files, and jaws, ears and fingers.
 
 mod arthropod;
 mod arthropod_actions;

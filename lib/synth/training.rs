@@ -9,6 +9,8 @@
 //! An *action* is what the body does: walking, running (trot, hop), idling, turning along a
 //! curve, walking-stopping-walking, undulating slowly or fast. All actions share one recipe
 //! (`route`): a ground track for the root, feet that land on it and stay planted, IK for legs.
+//! Variants from `RIG_VARIANTS` on also take a `Rig` (see `rig`): naming style, extra anatomy
+//! and wider neck and tail counts when the body is built, then axes, units and root OFFSET.
 
 use super::route::{Clock, FootPlan, FootSpec, Route};
 use super::*;
