@@ -18,6 +18,9 @@ pub(super) struct BipedBody {
     pub head: usize,
     /// (arm, forearm, hand) left then right.
     pub arms: Vec<(usize, usize, usize)>,
+    /// Rest rotation of each arm below the T-pose (left, right), `None` in a T-pose: world
+    /// rotations meant for a T-pose arm are multiplied by its inverse.
+    pub arm_rest: Option<[DQuat; 2]>,
     /// (IK chain, toe, hip x) left then right.
     pub legs: Vec<(Leg, usize, f64)>,
 }
@@ -40,15 +43,23 @@ pub(super) fn biped_body(shape: &Proportions, rig: &Rig) -> BipedBody {
     let head = b.add(&m(H::Head, None), neck, v3(0.0, 0.09 * neck_k, 0.01 * neck_k));
     b.end(head, v3(0.0, 0.18 * k, 0.0));
     let mut arms = Vec::new();
+    let drop = rig.arm_drop_degrees as f64;
+    let arm_rest = (drop > 0.0).then(|| [rz(-drop), rz(drop)]);
     for left in [true, false] {
         let s = if left { 1.0 } else { -1.0 };
         let side = Some(left);
+        // In an A-pose everything from the upper arm out hangs `drop` degrees lower; the
+        // clavicle stays level. (Only then rotated, so T-pose offsets keep their exact bits.)
+        let hang = |v: DVec3| match arm_rest {
+            Some(r) => r[usize::from(!left)] * v,
+            None => v,
+        };
         let sh = b.add(&m(H::Shoulder, side), spine2, v3(0.06 * s * k, 0.1 * k, 0.0));
         let arm = b.add(&m(H::Arm, side), sh, v3(0.12 * s * k, 0.0, 0.0));
-        let fore = b.add(&m(H::ForeArm, side), arm, v3(0.27 * s * arm_k, 0.0, 0.0));
-        let hand = b.add(&m(H::Hand, side), fore, v3(0.25 * s * arm_k, 0.0, 0.0));
+        let fore = b.add(&m(H::ForeArm, side), arm, hang(v3(0.27 * s * arm_k, 0.0, 0.0)));
+        let hand = b.add(&m(H::Hand, side), fore, hang(v3(0.25 * s * arm_k, 0.0, 0.0)));
         if rig.fingers == 0 {
-            b.end(hand, v3(0.18 * s * k, 0.0, 0.0));
+            b.end(hand, hang(v3(0.18 * s * k, 0.0, 0.0)));
         }
         // Fingers fan out from the palm along the hand's axis; the thumb sits forward and lower.
         // Five fingers are thumb..pinky, three are thumb, index and middle.
@@ -59,6 +70,7 @@ pub(super) fn biped_body(shape: &Proportions, rig: &Rig) -> BipedBody {
                 let z = 0.022 * k - 0.012 * k * (f - 1) as f64;
                 (v3(0.09 * s * k, 0.0, z), v3(0.028 * s * arm_k, 0.0, 0.0))
             };
+            let (base, step) = (hang(base), hang(step));
             let names: Vec<String> = (0..3).map(|i| m(H::Finger(f, i), side)).collect();
             let joints = b.chain(&names, hand, base, step);
             b.end(joints[2], step * 0.8);
@@ -76,13 +88,13 @@ pub(super) fn biped_body(shape: &Proportions, rig: &Rig) -> BipedBody {
         b.end(toe, v3(0.0, -0.02 * k, 0.06 * k));
         legs.push((Leg { upper: up, lower: knee, tip: Some(foot), rest_pole: DVec3::Z }, toe, 0.09 * s * k));
     }
-    BipedBody { skel: b.build(), spine: [spine, spine1, spine2], neck, head, arms, legs }
+    BipedBody { skel: b.build(), spine: [spine, spine1, spine2], neck, head, arms, arm_rest, legs }
 }
 
 /// Mixamo-named human walking: alternating legs, counter-swinging arms, a level head.
 pub(super) fn biped(rng: &mut SplitMix64) -> (Skeleton, Motion) {
     let body = biped_body(&training::proportions("biped", 0).expect("biped exists"), &Rig::NATIVE);
-    let BipedBody { skel, spine: [spine, spine1, spine2], neck, head, arms, legs } = body;
+    let BipedBody { skel, spine: [spine, spine1, spine2], neck, head, arms, legs, .. } = body;
 
     let (frames, period) = frames_for(rng.vary(1.1, 0.06), 3);
     let gait = Gait { period, duty: rng.vary(0.6, 0.03), stride: rng.vary(1.05, 0.08), lift: rng.vary(0.07, 0.1) };

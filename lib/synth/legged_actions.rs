@@ -55,7 +55,7 @@ impl Idle {
 
 pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
     let shape = job.shape;
-    let BipedBody { skel, spine, neck, head, arms, legs } = biped_body(&shape, &job.rig);
+    let BipedBody { skel, spine, neck, head, arms, arm_rest, legs } = biped_body(&shape, &job.rig);
     let (k, r) = (shape.size, shape.size * shape.limbs);
     let leg_len = 0.84 * r;
     let run = job.action == Action::Run;
@@ -113,6 +113,11 @@ pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
             let hang = -80.0 + 4.0 * rest * idle.breath(t);
             let (upper, lower) = (rx(swing) * rz(hang), rx(swing - bend) * rz(hang));
             let (upper, lower) = if side == 0 { (upper, lower) } else { (mirror(upper), mirror(lower)) };
+            // The rotations are meant for a T-pose arm: an A-pose arm is first raised to it.
+            let (upper, lower) = match arm_rest {
+                Some(r) => (upper * r[side].inverse(), lower * r[side].inverse()),
+                None => (upper, lower),
+            };
             p.world(arm, frame.rot() * upper);
             p.world(fore, frame.rot() * lower);
             p.world(hand, frame.rot() * lower);

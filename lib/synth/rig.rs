@@ -56,11 +56,15 @@ pub struct Rig {
     pub jaw_and_ears: bool,
     /// Fingers per hand (0, 3 or 5) on the biped, three joints each.
     pub fingers: usize,
+    /// How far the biped's arms hang below horizontal in the rest pose, in degrees: 0 is a
+    /// T-pose, 30-50 an A-pose (the natural stance many rigs are modelled in).
+    pub arm_drop_degrees: u32,
 }
 
 impl Rig {
     /// What the example creatures and variants below `RIG_VARIANTS` use.
-    pub const NATIVE: Rig = Rig { naming: Naming::Native, up: UpAxis::Y, centimetres: false, root_at_origin: false, jaw_and_ears: false, fingers: 0 };
+    pub const NATIVE: Rig =
+        Rig { naming: Naming::Native, up: UpAxis::Y, centimetres: false, root_at_origin: false, jaw_and_ears: false, fingers: 0, arm_drop_degrees: 0 };
 }
 
 /// The rig of `variant` of creature `name` (`None` for an unknown creature).
@@ -89,7 +93,8 @@ pub fn rig(name: &str, variant: u64) -> Option<Rig> {
         ("biped", Naming::Mixamo | Naming::Biped) => [0, 3, 5, 5][rng.below(4)],
         _ => 0,
     };
-    Some(Rig { naming, up, centimetres, root_at_origin, jaw_and_ears, fingers })
+    let arm_drop_degrees = if name == "biped" && rng.unit() < 0.5 { 30 + rng.below(21) as u32 } else { 0 };
+    Some(Rig { naming, up, centimetres, root_at_origin, jaw_and_ears, fingers, arm_drop_degrees })
 }
 
 /// Joint-count ranges (body, neck, tail) that rig variants draw from where they differ from

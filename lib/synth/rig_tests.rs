@@ -234,3 +234,27 @@ fn rig_variants_are_deterministic_and_round_trip_through_the_reader() {
         }
     }
 }
+
+#[test]
+fn a_pose_arms_hang_at_rest_but_move_as_t_pose_arms_do() {
+    use super::legged_actions;
+    use super::training::Job;
+    let v = find("biped", |r| r.arm_drop_degrees > 0);
+    let shape = proportions("biped", v).unwrap();
+    let a_pose = rig("biped", v).unwrap();
+    let t_pose = Rig { arm_drop_degrees: 0, ..a_pose };
+    let make = |rig: Rig| legged_actions::biped(&Job { shape, action: Action::Walk, frames: FRAMES, rig }, &mut SplitMix64::new(9));
+    let (a, t) = (make(a_pose), make(t_pose));
+    // At rest the hand hangs below the shoulder by the drop angle.
+    let hand = a.skeleton.index_of(&human_name(a_pose.naming, super::rig::HumanPart::Hand, Some(true))).unwrap();
+    let arm = a.skeleton.joints[a.skeleton.joints[hand].parent.unwrap()].parent.unwrap();
+    let rest = a.skeleton.rest_positions();
+    let d = rest[hand] - rest[arm];
+    let angle = (-d.y).atan2(d.x).to_degrees();
+    assert!((angle - a_pose.arm_drop_degrees as f64).abs() < 0.1, "biped v{v}: the arm hangs {angle:.2} degrees, not {}", a_pose.arm_drop_degrees);
+    assert!(t.skeleton.rest_positions()[hand].y > rest[hand].y + 0.05, "the T-pose hand is not higher");
+    // In motion every joint is where the T-pose body puts it.
+    let (fa, ft) = (a.motion.forward_kinematics(&a.skeleton), t.motion.forward_kinematics(&t.skeleton));
+    let worst = fa.positions.iter().zip(&ft.positions).map(|(p, q)| p.distance(*q)).fold(0.0, f64::max);
+    assert!(worst < 1e-3, "biped v{v}: A-pose motion differs by {worst}");
+}
