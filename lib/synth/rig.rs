@@ -232,3 +232,36 @@ pub(crate) fn apply(rig: &Rig, clip: &mut Clip) {
         }
     }
 }
+
+/// 3ds Max Biped files put the body's centre node `Bip01` above `Bip01_Pelvis`: `Bip01` carries
+/// the position and orientation, the pelvis hangs from it with a zero offset and rotation
+/// channels only. A re-expression: every joint stays where it was.
+pub(crate) fn add_biped_centre(clip: &mut Clip) {
+    let skel = &mut clip.skeleton;
+    let mut centre = skel.joints[0].clone();
+    centre.name = "Bip01".into();
+    centre.end_sites.clear();
+    let pelvis = &mut skel.joints[0];
+    pelvis.parent = Some(0);
+    pelvis.offset = DVec3::ZERO;
+    pelvis.channels.retain(|c| c.is_rotation());
+    for joint in skel.joints.iter_mut().skip(1) {
+        joint.parent = joint.parent.map(|p| p + 1);
+    }
+    skel.joints.insert(0, centre);
+    let m = &mut clip.motion;
+    let n = m.joints;
+    let mut rotations = Vec::with_capacity(m.frames * (n + 1));
+    let mut translations = Vec::with_capacity(m.frames * (n + 1));
+    for f in 0..m.frames {
+        let (r, t) = (&m.rotations[f * n..(f + 1) * n], &m.translations[f * n..(f + 1) * n]);
+        rotations.extend([r[0], DQuat::IDENTITY]);
+        rotations.extend_from_slice(&r[1..]);
+        translations.extend([t[0], DVec3::ZERO]);
+        translations.extend_from_slice(&t[1..]);
+    }
+    m.rotations = rotations;
+    m.translations = translations;
+    m.joints = n + 1;
+    debug_assert!(skel.validate().is_ok());
+}

@@ -60,6 +60,9 @@ fn every_human_naming_style_appears_with_its_names() {
     for &(naming, wanted) in expect {
         let v = find("biped", |r| r.naming == naming);
         let got = joint_names(&clip("biped", v));
+        if naming == Naming::Biped {
+            biped_centre_carries_the_pelvis("biped", v);
+        }
         for w in wanted {
             assert!(got.contains(*w), "biped v{v} {naming:?}: no {w} in {got:?}");
         }
@@ -81,6 +84,7 @@ fn biped_style_quadrupeds_have_horse_links_and_bn_tails() {
         for w in ["Bip01_L_Thigh", "Bip01_L_Calf", "Bip01_L_HorseLink", "Bip01_R_HorseLink", "Bip01_Spine1", "BN_Tail_01", "Bip01_Head"] {
             assert!(got.contains(w), "{name} v{v}: no {w} in {got:?}");
         }
+        biped_centre_carries_the_pelvis(name, v);
     }
 }
 
@@ -257,4 +261,21 @@ fn a_pose_arms_hang_at_rest_but_move_as_t_pose_arms_do() {
     let (fa, ft) = (a.motion.forward_kinematics(&a.skeleton), t.motion.forward_kinematics(&t.skeleton));
     let worst = fa.positions.iter().zip(&ft.positions).map(|(p, q)| p.distance(*q)).fold(0.0, f64::max);
     assert!(worst < 1e-3, "biped v{v}: A-pose motion differs by {worst}");
+}
+
+/// `Bip01` is the root, `Bip01_Pelvis` its only direct child at a zero offset, and the body
+/// moves exactly as the same clip without the centre node.
+fn biped_centre_carries_the_pelvis(name: &str, v: u64) {
+    let (c, r) = native_clip(name, v, main_action(name), 4, FRAMES).unwrap();
+    assert_eq!(r.naming, Naming::Biped);
+    let skel = &c.skeleton;
+    assert_eq!(skel.joints[0].name, "Bip01", "{name} v{v}");
+    assert_eq!(skel.joints[1].name, "Bip01_Pelvis", "{name} v{v}");
+    assert_eq!((skel.joints[1].parent, skel.joints[1].offset), (Some(0), DVec3::ZERO), "{name} v{v}");
+    assert_eq!(skel.children()[0], vec![1], "{name} v{v}");
+    assert_eq!(skel.joints[1].channels.len(), 3, "{name} v{v}: the pelvis has rotation channels only");
+    // Dropping the centre again gives the body as built: the pelvis takes its motion back.
+    let world = c.motion.forward_kinematics(skel);
+    let root = (0..c.motion.frames).map(|f| world.position(f, 0).distance(world.position(f, 1))).fold(0.0, f64::max);
+    assert!(root < 1e-12, "{name} v{v}: the pelvis is {root} from Bip01");
 }

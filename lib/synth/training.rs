@@ -170,6 +170,10 @@ pub(crate) fn native_clip(name: &str, variant: u64, action: Action, seed: u64, f
         "snake" => body_actions::snake(&job, &mut rng),
         _ => body_actions::fish(&job, &mut rng),
     };
+    let mut clip = clip;
+    if rig.naming == Naming::Biped {
+        rig::add_biped_centre(&mut clip);
+    }
     Some((clip, rig))
 }
 
