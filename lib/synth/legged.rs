@@ -429,12 +429,14 @@ fn quad_body(spec: &QuadSpec) -> QuadBody {
     add_leg(&mut b, 0, false, false);
     let mut tail = Vec::new();
     parent = 0;
+    // Tails of more than 12 joints (rig variants) are as long as a 12-joint one, finer cut.
+    let tail_bone = if spec.tail > 12 { 0.1 * tk * 12.0 / spec.tail as f64 } else { 0.1 * tk };
     for i in 0..spec.tail {
-        let off = if i == 0 { v3(0.0, 0.03 * k, -0.08 * k) } else { v3(0.0, 0.0, -0.1 * tk) };
+        let off = if i == 0 { v3(0.0, 0.03 * k, -0.08 * k) } else { v3(0.0, 0.0, -tail_bone) };
         parent = b.add(&name(Part::Tail(i), None), parent, off);
         tail.push(parent);
     }
-    b.end(parent, v3(0.0, 0.0, -0.1 * tk));
+    b.end(parent, v3(0.0, 0.0, -tail_bone));
     QuadBody { skel: b.build(), spine, neck, head, jaw, ears, tail, wings, legs, hip_drop, bone, ankle_y }
 }
 

@@ -225,12 +225,14 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
         }
         // Walking, the tail lags the hips; standing, it swishes on its own slower rhythm.
         let n_tail = tail.len() as f64;
+        // A degree of droop per joint, spread thinner on tails longer than 12 joints.
+        let droop = if tail.len() > 12 { -12.0 / n_tail } else { -1.0 };
         for (i, &j) in tail.iter().enumerate() {
             let x = (i + 1) as f64;
             let sway = tail_sway * (0.6 + 0.4 * i as f64 / n_tail) * 4.0 / n_tail.max(1.0);
             let walk = a * wave(c - 0.12 * x * 4.0 / n_tail);
             let swish = rest * 0.7 * wave(t / wag_period - 0.12 * x * 4.0 / n_tail);
-            p.local(j, ry(sway * (walk + swish)) * rx(if i == 0 { 8.0 } else { -1.0 }));
+            p.local(j, ry(sway * (walk + swish)) * rx(if i == 0 { 8.0 } else { droop }));
         }
         for (side, w) in wings.iter().enumerate() {
             // Flapping while moving (for balance), folded and stirring while standing.

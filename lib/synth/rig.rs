@@ -101,8 +101,10 @@ pub fn rig(name: &str, variant: u64) -> Option<Rig> {
 /// the family's usual ones: longer necks and tails, so skeletons span about 20-80 joints.
 pub(crate) fn wide_counts(name: &str) -> Option<[(usize, usize); 3]> {
     match name {
-        "quadruped" => Some([(2, 6), (1, 4), (2, 14)]),
-        "dragon" => Some([(2, 5), (2, 8), (5, 28)]),
+        // At most 1 + 6 + 4 + 4 (head, jaw, ears) + 16 + 16 + 1 (Bip01) = 48 joints.
+        "quadruped" => Some([(2, 6), (1, 4), (2, 16)]),
+        // At most 1 + 5 + 10 + 4 + 6 (wings) + 16 + 36 + 1 = 79 joints.
+        "dragon" => Some([(2, 5), (2, 10), (5, 36)]),
         _ => None,
     }
 }

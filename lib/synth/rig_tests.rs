@@ -213,7 +213,7 @@ fn joint_counts_span_twenty_to_eighty() {
         }
     }
     let (lo, hi) = (all.iter().min().unwrap(), all.iter().max().unwrap());
-    assert!(*lo <= 26 && *hi >= 55, "joint counts only span {lo}..{hi}");
+    assert!(*lo <= 26 && *hi >= 65, "joint counts only span {lo}..{hi}");
 }
 
 #[test]
@@ -278,4 +278,19 @@ fn biped_centre_carries_the_pelvis(name: &str, v: u64) {
     let world = c.motion.forward_kinematics(skel);
     let root = (0..c.motion.frames).map(|f| world.position(f, 0).distance(world.position(f, 1))).fold(0.0, f64::max);
     assert!(root < 1e-12, "{name} v{v}: the pelvis is {root} from Bip01");
+}
+
+#[test]
+fn long_necks_and_tails_stay_above_the_ground_in_every_action() {
+    for name in ["quadruped", "dragon"] {
+        for v in RIG_VARIANTS..RIG_VARIANTS + 16 {
+            for &action in actions(name) {
+                let (c, _) = native_clip(name, v, action, 2, FRAMES).unwrap();
+                let world = c.motion.forward_kinematics(&c.skeleton);
+                let lowest = world.positions.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+                let h = c.skeleton.rest_height();
+                assert!(lowest > -0.01 * h, "{name} v{v} {action:?}: a joint reaches y = {lowest:.3} (height {h:.3})");
+            }
+        }
+    }
 }
