@@ -225,13 +225,7 @@ impl<'a> Plan<'a> {
         let longest = examples.iter().map(|e| e.frames).max().unwrap_or(1);
         let frames = settings.frames.unwrap_or(longest);
         let mut notes = Vec::new();
-        let patch = settings.patch.min(frames).min(longest).max(1);
-        if patch < settings.patch {
-            notes.push(format!("patch shrunk from {} to {} frames (the output or every example clip is shorter)", settings.patch, patch));
-        }
-        for (i, e) in examples.iter().enumerate().filter(|(_, e)| e.frames < patch) {
-            notes.push(format!("example clip {i} ({} frames) is shorter than a patch and is not used", e.frames));
-        }
+        let patch = pyramid::fit_patch(settings.patch, frames, &examples.iter().map(|e| e.frames).collect::<Vec<_>>(), &mut notes);
         let lengths = pyramid::output_levels(frames, longest, patch, settings.coarse_patches, settings.pyramid);
         let scale = channels::feature_scale(skeleton);
         let width = channels::rotation_width(skeleton.len()) + 1;

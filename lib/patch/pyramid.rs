@@ -34,6 +34,21 @@ pub(crate) fn lengths(len: usize, ratio: f64, factor: f64) -> Vec<usize> {
 /// level holds about `coarse_patches * patch` frames), minus the coarse levels shorter than a
 /// patch. The reference keeps those and crashes when the target is more than ~5x longer than
 /// the source.
+/// The patch length both syntheses use: `requested`, no longer than the output (`frames`) or
+/// the longest example clip, and at least 1. Notes when it had to shrink, and for every example
+/// clip shorter than the patch (such a clip has no patch to match and is not used).
+pub(crate) fn fit_patch(requested: usize, frames: usize, example_frames: &[usize], notes: &mut Vec<String>) -> usize {
+    let longest = example_frames.iter().copied().max().unwrap_or(1);
+    let patch = requested.min(frames).min(longest).max(1);
+    if patch < requested {
+        notes.push(format!("patch shrunk from {requested} to {patch} frames (the output or every example clip is shorter)"));
+    }
+    for (i, f) in example_frames.iter().enumerate().filter(|(_, &f)| f < patch) {
+        notes.push(format!("example clip {i} ({f} frames) is shorter than a patch and is not used"));
+    }
+    patch
+}
+
 pub(crate) fn output_levels(frames: usize, longest_example: usize, patch: usize, coarse_patches: f64, factor: f64) -> Vec<usize> {
     let ratio = (coarse_patches * patch as f64 / longest_example.max(1) as f64).min(1.0);
     let mut levels: Vec<usize> = lengths(frames, ratio, factor).into_iter().filter(|&l| l >= patch).collect();
