@@ -21,7 +21,7 @@ use common::{denoiser_forward_flops, median};
 use candle_core::{DType, Device, Tensor};
 use menagerie::cli::load::{expand_inputs, load_motions, LoadOptions};
 use menagerie::diffusion::data::{Augmentation, RawClip, TrainSet};
-use menagerie::diffusion::trainer::{step_rng, AnyTopOptions, AnyTopTrainer, Trainer};
+use menagerie::diffusion::trainer::{step_rng, AnyTopOptions, AnyTopStart, AnyTopTrainer, Trainer};
 use menagerie::embed::NameTable;
 use menagerie::nn::DenoiserConfig;
 use menagerie::skeleton::topology;
@@ -135,7 +135,7 @@ fn main() {
         .iter()
         .map(|&n| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().expect("a thread pool");
-            let trainer = AnyTopTrainer::new(&scratch.join(n.to_string()), &opts, None, build_set(), &dev).expect("a trainer");
+            let trainer = AnyTopTrainer::new(&scratch.join(n.to_string()), &opts, AnyTopStart::New, build_set(), &dev).expect("a trainer");
             let peak = pool.install(matmul_peak);
             (n, pool, trainer, peak)
         })

@@ -4,7 +4,9 @@ use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, RawClip, TrainSet};
-use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopResume, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
+use crate::diffusion::trainer::{
+    refuse_existing, train_loop, AnyTopInit, AnyTopOptions, AnyTopResume, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer,
+};
 use crate::embed::NameTable;
 use crate::nn::DenoiserConfig;
 use crate::sata::trainer::{SataOptions, SataResume, SataTrainer};
@@ -20,7 +22,11 @@ const EXAMPLES: &str = "\
 EXAMPLES:
     mo-train examples/data --out model --preset tiny --steps 3 --batch 2 --crop 16
     mo-train examples/data --out model --preset tiny --steps 5 --batch 2 --crop 16 --resume
-    mo-train examples/data --out model2 --preset tiny --steps 3 --batch 2 --crop 16 --augment 0";
+    mo-train examples/data --out model2 --preset tiny --steps 3 --batch 2 --crop 16 --augment 0
+
+  Your own creature: fine-tune the built-in model on its clips for 5 minutes, then sample it
+    mo-train my_creature/ --init builtin --minutes 5 --out my_model
+    mo-sample my_creature/walk.bvh --model my_model -n 4 --bvh 'new_{}.bvh'";
 
 /// Train the diffusion model (AnyTop's denoiser) on BVH clips of any skeletons.
 ///
@@ -52,6 +58,12 @@ EXAMPLES:
 /// stays whole). A JSON-lines log (step, loss, steps/s) is appended to OUT/log.jsonl. On a
 /// terminal a progress bar shows loss, steps/s and ETA; otherwise a line every 50 steps.
 /// The same data, flags and --seed give the same run.
+///
+/// Fine-tuning (--init builtin or --init DIR): the run starts from that model's weights,
+/// size and noise schedule instead of random weights, with a fresh optimiser and the new
+/// clips' own statistics; it defaults to --lr 3e-4 and --augment 0 (every draw is of
+/// your skeletons). With --minutes it trains for a wall-time budget rather than a step count.
+/// The result is an ordinary model directory for mo-sample, mo-dift and mo-segment --model.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-train", version, after_long_help = EXAMPLES)]
 pub struct Args {
@@ -64,9 +76,19 @@ pub struct Args {
     /// Model size: tiny, small or paper (width 128, 4 layers, 4 heads).
     #[arg(long, value_enum, default_value_t = Preset::Small)]
     pub preset: Preset,
-    /// Training steps in total (a resumed run counts the steps already done).
-    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=bounds::MAX_TRAIN_STEPS))]
-    pub steps: u64,
+    /// Training steps in total (a resumed run counts the steps already done) [default: 10000,
+    /// or no limit with --minutes].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=bounds::MAX_TRAIN_STEPS))]
+    pub steps: Option<u64>,
+    /// Train for this much wall time (this invocation's), then save and stop; with --steps,
+    /// whichever comes first. The progress bar then shows the time left.
+    #[arg(long, value_name = "M", value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
+    pub minutes: Option<f64>,
+    /// anytop: start from a trained model instead of random weights: 'builtin' (the model
+    /// inside the binaries) or a model directory written by mo-train (use ./builtin for a
+    /// directory of that name). A new run only: with --resume the checkpoint in --out goes on.
+    #[arg(long, value_name = "builtin|DIR")]
+    pub init: Option<PathBuf>,
     /// Crops per step.
     #[arg(long, value_name = "N", default_value_t = 16, value_parser = clap::value_parser!(u64).range(1..=1024))]
     pub batch: u64,
@@ -88,11 +110,11 @@ pub struct Args {
     /// run keeps its checkpoint's unless this is given.
     #[arg(long, value_name = "W", value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
     pub lambda_cycle: Option<f64>,
-    /// Learning rate.
+    /// Learning rate [default: 1e-4; with --init 3e-4].
     // Finite and positive, no upper bound: a rate that blows a model up is stopped by the
     // training loop's non-finite loss check (and tests use one for that).
-    #[arg(long, value_name = "LR", default_value_t = 1e-4, value_parser = bounds::positive(f64::MAX))]
-    pub lr: f64,
+    #[arg(long, value_name = "LR", value_parser = bounds::positive(f64::MAX))]
+    pub lr: Option<f64>,
     /// Weight of the geodesic rotation loss (the angle, in radians, between predicted and true
     /// joint rotations) next to the MSE; the reference trains with 1.
     #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
@@ -103,9 +125,9 @@ pub struct Args {
     #[arg(long, value_name = "W", default_value_t = 0.0, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
     pub lambda_vel: f64,
     /// Chance that a training draw uses an augmented skeleton (joints removed or added), as a
-    /// number in [0, 1] or a fraction like 2/3.
-    #[arg(long, value_name = "P", default_value = "2/3", value_parser = parse_probability)]
-    pub augment: f64,
+    /// number in [0, 1] or a fraction like 2/3 [default: 2/3; with --init 0].
+    #[arg(long, value_name = "P", value_parser = parse_probability)]
+    pub augment: Option<f64>,
     /// Augmented variants prepared per skeleton (alternately removing and adding joints).
     #[arg(long, value_name = "N", default_value_t = Augmentation::DEFAULT_VARIANTS as u64, value_parser = clap::value_parser!(u64).range(0..=64))]
     pub augment_variants: u64,
@@ -233,11 +255,36 @@ fn bar(done: u64, total: u64, width: usize) -> String {
     format!("[{}{}]", "#".repeat(filled), ".".repeat(width - filled))
 }
 
+/// The learning rate of a fine-tune (`--init`) when none is given.
+pub const INIT_LR: f64 = 3e-4;
+
+/// The settings whose defaults depend on other flags.
+struct Resolved {
+    lr: f64,
+    augment: f64,
+    steps: u64,
+}
+
+impl Resolved {
+    fn of(args: &Args) -> Resolved {
+        let fine_tune = args.init.is_some();
+        Resolved {
+            lr: args.lr.unwrap_or(if fine_tune { INIT_LR } else { 1e-4 }),
+            augment: args.augment.unwrap_or(if fine_tune { 0.0 } else { 2.0 / 3.0 }),
+            steps: args.steps.unwrap_or(if args.minutes.is_some() { bounds::MAX_TRAIN_STEPS } else { 10_000 }),
+        }
+    }
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     crate::nn::keep_freed_memory();
-    if !(args.lr.is_finite() && args.lr > 0.0) {
-        bail!("--lr must be a positive number, found {}", args.lr);
+    let resolved = Resolved::of(args);
+    if !(resolved.lr.is_finite() && resolved.lr > 0.0) {
+        bail!("--lr must be a positive number, found {}", resolved.lr);
+    }
+    if args.init.is_some() && args.arch != Arch::Anytop {
+        bail!("--init fine-tunes the diffusion model (--arch anytop), not --arch sata");
     }
     // Before any work or message: --out must be (or become) a directory.
     if args.out.exists() && !args.out.is_dir() {
@@ -257,30 +304,43 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let opts = AnyTopOptions {
                 config: args.preset.config(),
                 seed: args.common.seed,
-                lr: args.lr,
+                lr: resolved.lr,
                 batch: args.batch as usize,
                 crop: args.crop.unwrap_or(40) as usize,
                 lambda_geo: args.lambda_geo,
                 lambda_vel: args.lambda_vel,
-                augment: args.augment,
+                augment: resolved.augment,
                 augment_variants: args.augment_variants as usize,
                 ema: args.ema,
                 noise_shift: args.noise_shift,
             };
             // The checkpoint first: a resumed run must rebuild the data (augmented variants
             // included) from the seed the run started with.
-            let resume = if args.resume { Some(AnyTopResume::load(&args.out, args.lr, &device)?) } else { None };
-            let (seed, dmax) = resume.as_ref().map_or((opts.seed, topology::DEFAULT_DMAX), |r| (r.info().seed, r.info().dmax));
-            if resume.as_ref().is_some_and(|r| r.differs(&opts)) {
-                say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
-            }
-            if let Some((old, new)) = resume.as_ref().and_then(|r| r.shift_changes(&opts)) {
-                say(args, &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
-            }
+            let start = if args.resume {
+                let resume = AnyTopResume::load(&args.out, resolved.lr, &device)?;
+                if resume.differs(&opts) {
+                    say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
+                }
+                if let Some((old, new)) = resume.shift_changes(&opts) {
+                    say(args, &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
+                }
+                AnyTopStart::Resume(resume)
+            } else if let Some(init) = &args.init {
+                refuse_to_overwrite(args)?;
+                let init = if init.as_os_str() == "builtin" { AnyTopInit::builtin(&device)? } else { AnyTopInit::load(init, &device)? };
+                say(args, &format!("fine-tuning {} (its size and noise schedule; --preset is not used)", init.source()));
+                AnyTopStart::Init(init)
+            } else {
+                AnyTopStart::New
+            };
+            let seed = match &start {
+                AnyTopStart::Resume(r) => r.info().seed,
+                _ => opts.seed,
+            };
             refuse_to_overwrite(args)?;
-            let set = training_set(args, seed, dmax)?;
-            let mut trainer = AnyTopTrainer::new(&args.out, &opts, resume, set, &device).map_err(explain)?;
-            train(args, trainer.first_step(), &mut trainer)
+            let set = training_set(args, &resolved, seed, start.dmax())?;
+            let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, &device).map_err(explain)?;
+            train(args, &resolved, trainer.first_step(), &mut trainer)
         }
         Arch::Sata => {
             let mut config = args.preset.sata();
@@ -291,14 +351,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let opts = SataOptions {
                 config,
                 seed: args.common.seed,
-                lr: args.lr,
+                lr: resolved.lr,
                 batch: args.batch as usize,
-                augment: args.augment,
+                augment: resolved.augment,
                 augment_variants: args.augment_variants as usize,
                 lambda_kl: args.lambda_kl,
                 lambda_cycle: args.lambda_cycle,
             };
-            let resume = if args.resume { Some(SataResume::load(&args.out, args.lr, &device)?) } else { None };
+            let resume = if args.resume { Some(SataResume::load(&args.out, resolved.lr, &device)?) } else { None };
             if resume.as_ref().is_some_and(|r| r.differs(&opts)) {
                 say(args, "note: --batch, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
             }
@@ -307,9 +367,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 opts.config.validate()?;
             }
             let seed = resume.as_ref().map_or(opts.seed, |r| r.info().seed);
-            let set = training_set(args, seed, topology::DEFAULT_DMAX)?;
+            let set = training_set(args, &resolved, seed, topology::DEFAULT_DMAX)?;
             let mut trainer = SataTrainer::new(&args.out, &opts, resume, set, &device).map_err(explain)?;
-            train(args, trainer.first_step(), &mut trainer)
+            train(args, &resolved, trainer.first_step(), &mut trainer)
         }
     }?;
     if !args.common.quiet {
@@ -344,22 +404,37 @@ fn explain(e: TrainError) -> anyhow::Error {
 
 /// The loop with a progress bar on a terminal (a line every 50 steps otherwise) and Ctrl-C;
 /// returns the steps done.
-fn train(args: &Args, first: u64, trainer: &mut impl Trainer) -> anyhow::Result<u64> {
+fn train(args: &Args, resolved: &Resolved, first: u64, trainer: &mut impl Trainer) -> anyhow::Result<u64> {
     catch_interrupts()?;
-    let opts = LoopOptions { out: args.out.clone(), steps: args.steps, checkpoint_every: Duration::from_secs_f64(args.checkpoint_minutes.max(0.0) * 60.0) };
+    let opts = LoopOptions {
+        out: args.out.clone(),
+        steps: resolved.steps,
+        checkpoint_every: Duration::from_secs_f64(args.checkpoint_minutes.max(0.0) * 60.0),
+        budget: args.minutes.map(|m| Duration::from_secs_f64(m * 60.0)),
+    };
     let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr()) && !args.common.quiet;
     let mut last_draw: Option<Instant> = None;
     let result = train_loop(&opts, first, trainer, &STOP, |p| {
         let (step, steps, loss, rate, eta) = (p.step, p.steps, p.loss, p.rate, duration(p.eta_seconds));
+        // With a time budget the bar fills with time, and the step count has no total
+        // unless --steps set one.
+        let last = step == steps || p.budget_used.is_some_and(|u| u >= 1.0);
+        let count = match (p.budget_used, args.steps) {
+            (Some(_), None) => format!("step {step}"),
+            _ => format!("step {step:>width$}/{steps}", width = steps.to_string().len()),
+        };
+        let (done, total, left) = match p.budget_used {
+            Some(u) => ((u * 1000.0).round() as u64, 1000, format!("{eta} left")),
+            None => (step, steps, format!("ETA {eta}")),
+        };
         if terminal {
             // Redraw at most ten times a second: fast tiny models would flood the terminal.
-            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || step == steps {
-                let width = steps.to_string().len();
-                eprint!("\rmo-train: {} {step:>width$}/{steps}  loss {loss:.4}  {rate:.2} steps/s  ETA {eta}   ", bar(step, steps, 30));
+            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || last {
+                eprint!("\rmo-train: {} {count}  loss {loss:.4}  {rate:.2} steps/s  {left}   ", bar(done, total, 30));
                 last_draw = Some(Instant::now());
             }
-        } else if !args.common.quiet && (step % 50 == 0 || step == steps) {
-            eprintln!("mo-train: step {step}/{steps}  loss {loss:.4}  {rate:.2} steps/s  ETA {eta}");
+        } else if !args.common.quiet && (step % 50 == 0 || last) {
+            eprintln!("mo-train: {count}  loss {loss:.4}  {rate:.2} steps/s  {left}");
         }
     });
     if terminal {
@@ -369,13 +444,13 @@ fn train(args: &Args, first: u64, trainer: &mut impl Trainer) -> anyhow::Result<
 }
 
 /// The clips of DATA grouped by skeleton, with augmented variants, as both architectures use.
-fn training_set(args: &Args, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
+fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
     let say = |msg: String| say(args, &msg);
     let files = expand_inputs(&args.data)?;
     let loaded = load_motions(&files, &LoadOptions::default())?;
     let clips: Vec<RawClip> = loaded.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
     let names = NameTable::builtin().context("the built-in joint-name table")?;
-    let augmentation = Augmentation { probability: args.augment, variants: args.augment_variants as usize, seed };
+    let augmentation = Augmentation { probability: resolved.augment, variants: args.augment_variants as usize, seed };
     let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;
     for d in &dropped {
         say(format!("{d}: too short to crop, left out"));

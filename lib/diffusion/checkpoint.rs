@@ -118,6 +118,10 @@ pub struct CheckpointInfo {
     /// before it existed.
     #[serde(default = "no_shift")]
     pub noise_shift: f64,
+    /// The model a fine-tune started from (`mo-train --init`), as "the built-in default model
+    /// (step N)" or "model DIR (step N)"; absent for a run from random weights.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub init: Option<String>,
     pub skeletons: Vec<TrainedSkeleton>,
 }
 
@@ -272,9 +276,18 @@ pub fn frozen(dir: &Path, device: &Device) -> Result<Frozen, CheckpointError> {
 /// The default model that ships inside the binaries: a `small` denoiser trained on the
 /// synthetic zoo (models/zoo-small, see its MODEL_CARD.md).
 pub fn frozen_default(device: &Device) -> Result<Frozen, CheckpointError> {
-    const INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
-    const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");
-    frozen_bytes(INFO, WEIGHTS, device).map_err(CheckpointError::of("the built-in default model".into()))
+    frozen_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))
+}
+
+/// The built-in model's `checkpoint.json` and `model.safetensors`, embedded in the binaries.
+pub const BUILTIN_INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
+pub const BUILTIN_WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");
+/// How messages name the built-in model.
+pub const BUILTIN_NAME: &str = "the built-in default model";
+
+/// The built-in model as trainable variables (a fine-tune's start, `mo-train --init builtin`).
+pub fn load_default(device: &Device) -> Result<Loaded, CheckpointError> {
+    load_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))
 }
 
 /// The raw weights an averaged checkpoint keeps beside its optimiser state (`w.<name>`), by

@@ -126,6 +126,9 @@ pub struct LoopOptions {
     pub steps: u64,
     /// Save a checkpoint at least this often.
     pub checkpoint_every: Duration,
+    /// Wall time this run may take (`mo-train --minutes`): the loop stops after the step that
+    /// reaches it, and saves. None = until `steps`.
+    pub budget: Option<Duration>,
 }
 
 /// One finished step, for a progress display.
@@ -137,7 +140,10 @@ pub struct Progress {
     pub loss: f64,
     /// Steps per second since this run started.
     pub rate: f64,
+    /// Seconds until the run ends: by `steps` at the current rate, or by the time budget.
     pub eta_seconds: f64,
+    /// The time budget's share used, in [0, 1] (None without a budget).
+    pub budget_used: Option<f64>,
 }
 
 /// One line of `log.jsonl`: step, loss, its parts, speed, elapsed seconds. Written by
@@ -164,8 +170,9 @@ impl Serialize for LogLine<'_> {
     }
 }
 
-/// Steps from `first` to `opts.steps` with the log, periodic checkpoints and the stop flag;
-/// `progress` is called after every step. Returns the steps done, all saved.
+/// Steps from `first` to `opts.steps` (or until the time budget is spent) with the log,
+/// periodic checkpoints and the stop flag; `progress` is called after every step. Returns the
+/// steps done, all saved.
 pub fn train_loop(opts: &LoopOptions, first: u64, trainer: &mut impl Trainer, stop: &StopFlag, mut progress: impl FnMut(&Progress)) -> Result<u64, TrainError> {
     std::fs::create_dir_all(&opts.out).map_err(|e| TrainError::CreateDir(opts.out.clone(), e))?;
     let mut log = std::fs::OpenOptions::new().create(true).append(true).open(opts.out.join("log.jsonl")).map_err(TrainError::OpenLog)?;
@@ -186,12 +193,19 @@ pub fn train_loop(opts: &LoopOptions, first: u64, trainer: &mut impl Trainer, st
         let done = step - first;
         let elapsed = started.elapsed().as_secs_f64();
         let rate = done as f64 / elapsed.max(1e-9);
-        let eta_seconds = (opts.steps - step) as f64 / rate.max(1e-9);
+        let mut eta_seconds = (opts.steps - step) as f64 / rate.max(1e-9);
+        let budget_used = opts.budget.map(|b| (elapsed / b.as_secs_f64().max(1e-9)).min(1.0));
+        if let Some(b) = opts.budget {
+            eta_seconds = eta_seconds.min((b.as_secs_f64() - elapsed).max(0.0));
+        }
         let line = LogLine { step, losses: &losses, rate, elapsed };
         let mut text = serde_json::to_vec(&line).map_err(|e| TrainError::WriteLog(e.into()))?;
         text.push(b'\n');
         log.write_all(&text).map_err(TrainError::WriteLog)?;
-        progress(&Progress { step, steps: opts.steps, loss: losses.total, rate, eta_seconds });
+        progress(&Progress { step, steps: opts.steps, loss: losses.total, rate, eta_seconds, budget_used });
+        if budget_used.is_some_and(|u| u >= 1.0) {
+            break;
+        }
         if last_save.elapsed() >= opts.checkpoint_every {
             stop.guard(|| trainer.save(step))?;
             saved = Some(step);
@@ -239,6 +253,60 @@ pub struct AnyTopOptions {
 /// 0.21-0.24 of the clips' with AnyTop's schedule (1), 0.38-0.61 at 10 with crop-relative
 /// positions. 20 and 40 were not better on a 1-skeleton proxy.
 pub const DEFAULT_NOISE_SHIFT: f64 = 10.0;
+
+/// Where a denoiser run starts.
+pub enum AnyTopStart {
+    /// New weights from the seed, with `AnyTopOptions::config`.
+    New,
+    /// A fine-tune (`mo-train --init`): another model's weights, config and noise schedule,
+    /// with a fresh optimiser, step 0, and the run's own skeletons and statistics.
+    Init(AnyTopInit),
+    /// The checkpoint in the output directory, continued exactly.
+    Resume(AnyTopResume),
+}
+
+impl AnyTopStart {
+    /// The topology distance limit the training set must be built with: the starting
+    /// model's, or the default for new weights.
+    pub fn dmax(&self) -> usize {
+        match self {
+            AnyTopStart::New => crate::skeleton::topology::DEFAULT_DMAX,
+            AnyTopStart::Init(i) => i.loaded.info.dmax,
+            AnyTopStart::Resume(r) => r.loaded.info.dmax,
+        }
+    }
+}
+
+/// A model whose weights start a new run.
+pub struct AnyTopInit {
+    loaded: checkpoint::Loaded,
+    /// How the checkpoint names it: "the built-in default model (step N)", "model DIR (step N)".
+    source: String,
+}
+
+impl AnyTopInit {
+    /// The model embedded in the binaries.
+    pub fn builtin(device: &Device) -> Result<AnyTopInit, TrainError> {
+        let loaded = checkpoint::load_default(device)?;
+        let source = format!("{} (step {})", checkpoint::BUILTIN_NAME, loaded.info.step);
+        Ok(AnyTopInit { loaded, source })
+    }
+
+    /// The model in `dir` (its averaged weights, the ones samplers use).
+    pub fn load(dir: &Path, device: &Device) -> Result<AnyTopInit, TrainError> {
+        let loaded = checkpoint::load(dir, device)?;
+        let source = format!("model {} (step {})", dir.display(), loaded.info.step);
+        Ok(AnyTopInit { loaded, source })
+    }
+
+    pub fn info(&self) -> &CheckpointInfo {
+        &self.loaded.info
+    }
+
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+}
 
 /// A denoiser checkpoint to continue, with its optimiser state.
 pub struct AnyTopResume {
@@ -295,34 +363,41 @@ pub struct AnyTopTrainer {
 }
 
 impl AnyTopTrainer {
-    /// A new run (`resume` none; `out` must not hold a checkpoint) or the continuation of
-    /// `resume`, on `set`, saving to `out`. A new run's set is built with `opts.seed` and
-    /// `topology::DEFAULT_DMAX`, a resumed one's with its checkpoint's.
-    pub fn new(out: &Path, opts: &AnyTopOptions, resume: Option<AnyTopResume>, set: TrainSet, device: &Device) -> Result<AnyTopTrainer, TrainError> {
-        let (varmap, model, opt, mut info, raw) = match resume {
-            Some(r) => (r.loaded.varmap, r.loaded.model, r.opt, r.loaded.info, r.raw),
-            None => {
+    /// A run from `start` on `set`, saving to `out` (which must not hold a checkpoint unless
+    /// the run resumes it). The set must be built with the dmax of `AnyTopStart::dmax`, and a
+    /// resumed run's with its checkpoint's seed.
+    pub fn new(out: &Path, opts: &AnyTopOptions, start: AnyTopStart, set: TrainSet, device: &Device) -> Result<AnyTopTrainer, TrainError> {
+        let fresh = |config: &DenoiserConfig, base: Option<&CheckpointInfo>| CheckpointInfo {
+            format: checkpoint::FORMAT.into(),
+            version: checkpoint::VERSION,
+            config: config.clone(),
+            step: 0,
+            seed: opts.seed,
+            schedule_steps: base.map_or(100, |b| b.schedule_steps),
+            lr: opts.lr,
+            batch: opts.batch,
+            crop: opts.crop,
+            dmax: base.map_or(crate::skeleton::topology::DEFAULT_DMAX, |b| b.dmax),
+            augment: 0.0,
+            augment_variants: 0,
+            ema: 0.0,
+            noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
+            init: None,
+            skeletons: Vec::new(),
+        };
+        let (varmap, model, opt, mut info, raw) = match start {
+            AnyTopStart::Resume(r) => (r.loaded.varmap, r.loaded.model, r.opt, r.loaded.info, r.raw),
+            AnyTopStart::New => {
                 refuse_existing(out)?;
                 let varmap = VarMap::new();
                 let model = Denoiser::new(seeded_var_builder(&varmap, opts.seed, device), &opts.config)?;
-                let info = CheckpointInfo {
-                    format: checkpoint::FORMAT.into(),
-                    version: checkpoint::VERSION,
-                    config: opts.config.clone(),
-                    step: 0,
-                    seed: opts.seed,
-                    schedule_steps: 100,
-                    lr: opts.lr,
-                    batch: opts.batch,
-                    crop: opts.crop,
-                    dmax: crate::skeleton::topology::DEFAULT_DMAX,
-                    augment: 0.0,
-                    augment_variants: 0,
-                    ema: 0.0,
-                    noise_shift: DEFAULT_NOISE_SHIFT,
-                    skeletons: Vec::new(),
-                };
-                (varmap, model, AdamW::new(opts.lr), info, Default::default())
+                (varmap, model, AdamW::new(opts.lr), fresh(&opts.config, None), Default::default())
+            }
+            AnyTopStart::Init(i) => {
+                refuse_existing(out)?;
+                let mut info = fresh(&i.loaded.info.config, Some(&i.loaded.info));
+                info.init = Some(i.source);
+                (i.loaded.varmap, i.loaded.model, AdamW::new(opts.lr), info, Default::default())
             }
         };
         if let Some(shift) = opts.noise_shift {
@@ -446,7 +521,7 @@ mod tests {
     fn a_non_finite_loss_stops_without_saving_or_logging_it() {
         for bad in [f64::NAN, f64::INFINITY] {
             let out = dir("nan");
-            let opts = LoopOptions { out: out.clone(), steps: 5, checkpoint_every: Duration::ZERO };
+            let opts = LoopOptions { out: out.clone(), steps: 5, checkpoint_every: Duration::ZERO, budget: None };
             let mut t = Scripted { losses: vec![1.0, 0.5, bad, 0.25, 0.1], saves: Vec::new() };
             let mut seen = Vec::new();
             let err = train_loop(&opts, 0, &mut t, &StopFlag::new(), |p| seen.push(p.step)).unwrap_err();
@@ -461,9 +536,20 @@ mod tests {
     }
 
     #[test]
+    fn a_spent_time_budget_ends_the_run_with_a_save() {
+        let out = dir("budget");
+        let opts = LoopOptions { out: out.clone(), steps: 1000, checkpoint_every: Duration::from_secs(3600), budget: Some(Duration::ZERO) };
+        let mut t = Scripted { losses: vec![1.0; 1000], saves: Vec::new() };
+        let mut used = Vec::new();
+        let done = train_loop(&opts, 4, &mut t, &StopFlag::new(), |p| used.push(p.budget_used)).unwrap();
+        assert_eq!((done, t.saves.as_slice(), used.as_slice()), (5, &[5][..], &[Some(1.0)][..]), "one step, then saved and stopped");
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
     fn a_stop_request_saves_at_the_step_boundary() {
         let out = dir("stop");
-        let opts = LoopOptions { out: out.clone(), steps: 5, checkpoint_every: Duration::from_secs(3600) };
+        let opts = LoopOptions { out: out.clone(), steps: 5, checkpoint_every: Duration::from_secs(3600), budget: None };
         let mut t = Scripted { losses: vec![1.0; 5], saves: Vec::new() };
         let stop = StopFlag::new();
         let err = train_loop(&opts, 1, &mut t, &stop, |p| {

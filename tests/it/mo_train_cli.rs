@@ -193,3 +193,75 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     common::check_failure("mo-train", "shift 0.5", &run("mo-train", &args, None), "--noise-shift");
     assert!(!other.join("checkpoint.json").exists());
 }
+
+/// `--init DIR` starts a new run from that model's weights, size and noise schedule, with the
+/// fine-tune defaults (--lr 3e-4, --augment 0) and a note of where it started; `--init
+/// builtin` does the same from the model inside the binaries; `--minutes` ends a run on time
+/// with a checkpoint; bad starts are one-line errors that write nothing.
+#[test]
+fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
+    let dir = tempdir("train-init");
+    let data = data(&dir);
+    let load = |p: PathBuf| candle_core::safetensors::load(p.join("model.safetensors"), &candle_core::Device::Cpu).unwrap();
+    let flat = |t: &candle_core::Tensor| t.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+    let base = dir.join("base");
+    let mut args = train_args(&data, &base, "3");
+    args.extend(["--noise-shift", "4"]);
+    ok(&run("mo-train", &args, None), "base");
+
+    // One step at a vanishing rate, no average: the weights are the base model's.
+    let tuned = dir.join("tuned");
+    let one = [s(&data[1]), "--init", s(&base), "--out", s(&tuned), "--steps", "1", "--batch", "2", "--crop", "12", "--checkpoint-minutes", "1000"];
+    let mut args = one.to_vec();
+    args.extend(["--lr", "1e-30", "--ema", "0"]);
+    let out = run("mo-train", &args, None);
+    ok(&out, "init from dir");
+    assert!(String::from_utf8_lossy(&out.stderr).contains(&format!("fine-tuning model {} (step 3)", base.display())), "{}", String::from_utf8_lossy(&out.stderr));
+    let (b, t) = (info(&base), info(&tuned));
+    assert_eq!((&t["config"], t["noise_shift"].as_f64(), t["step"].as_u64()), (&b["config"], Some(4.0), Some(1)));
+    assert_eq!(t["init"].as_str(), Some(format!("model {} (step 3)", base.display()).as_str()));
+    assert_eq!(t["skeletons"].as_array().map(|a| a.len()), Some(1), "only the new clips' skeleton");
+    let (bw, tw) = (load(base.clone()), load(tuned.clone()));
+    assert_eq!(bw.len(), tw.len());
+    for (name, w) in &bw {
+        let gap = flat(w).iter().zip(flat(&tw[name])).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(gap < 1e-6, "{name} moved by {gap} at lr 1e-30: not started from the base weights");
+    }
+    // Without --init the same run starts from random weights.
+    let scratch = dir.join("scratch");
+    let args = [s(&data[1]), "--out", s(&scratch), "--steps", "1", "--batch", "2", "--crop", "12", "--preset", "tiny", "--lr", "1e-30", "--ema", "0"];
+    ok(&run("mo-train", &args, None), "scratch");
+    let sw = load(scratch.clone());
+    assert!(bw.iter().any(|(n, w)| flat(w) != flat(&sw[n])), "a run from scratch equals the base model");
+
+    // The fine-tune defaults, recorded.
+    let defaults = dir.join("defaults");
+    let args: Vec<&str> = one.iter().map(|a| if *a == s(&tuned) { s(&defaults) } else { a }).collect();
+    ok(&run("mo-train", &args, None), "init defaults");
+    let d = info(&defaults);
+    assert_eq!((d["lr"].as_f64(), d["augment"].as_f64()), (Some(3e-4), Some(0.0)));
+
+    // The built-in model, for a wall-time budget: it stops on time, saves, and samples.
+    let builtin = dir.join("builtin");
+    let args = [s(&data[1]), "--init", "builtin", "--out", s(&builtin), "--minutes", "0.002", "--batch", "2", "--crop", "12"];
+    let out = run("mo-train", &args, None);
+    ok(&out, "init builtin");
+    let bi = info(&builtin);
+    assert!(bi["init"].as_str().is_some_and(|i| i.starts_with("the built-in default model (step ")), "{bi}");
+    assert_eq!((bi["config"]["width"].as_u64(), bi["noise_shift"].as_f64()), (Some(64), Some(10.0)));
+    let steps = bi["step"].as_u64().unwrap();
+    assert!((1..1000).contains(&steps), "a 0.12 s budget ran {steps} steps");
+    let sample = run("mo-sample", &[s(&data[1].join("quadruped_walk.bvh")), "--model", s(&builtin), "--frames", "8", "--steps", "3"], None);
+    ok(&sample, "sample the fine-tuned model");
+
+    // Bad starts write nothing.
+    let none = dir.join("none");
+    let missing = dir.join("no-such-model");
+    let args = [s(&data[1]), "--init", s(&missing), "--out", s(&none), "--steps", "1"];
+    common::check_failure("mo-train", "missing init", &run("mo-train", &args, None), "no-such-model");
+    let args = [s(&data[1]), "--init", "builtin", "--arch", "sata", "--out", s(&none), "--steps", "1"];
+    common::check_failure("mo-train", "sata init", &run("mo-train", &args, None), "--arch sata");
+    let args = [s(&data[1]), "--init", "builtin", "--out", s(&base), "--steps", "1"];
+    common::check_failure("mo-train", "init over a checkpoint", &run("mo-train", &args, None), "already holds a checkpoint");
+    assert!(!none.exists());
+}
