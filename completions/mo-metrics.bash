@@ -25,6 +25,9 @@ _mo__metrics() {
             mo__metrics,help)
                 cmd="mo__metrics__subcmd__help"
                 ;;
+            mo__metrics,ood)
+                cmd="mo__metrics__subcmd__ood"
+                ;;
             mo__metrics,physics)
                 cmd="mo__metrics__subcmd__physics"
                 ;;
@@ -43,6 +46,9 @@ _mo__metrics() {
             mo__metrics__subcmd__help,help)
                 cmd="mo__metrics__subcmd__help__subcmd__help"
                 ;;
+            mo__metrics__subcmd__help,ood)
+                cmd="mo__metrics__subcmd__help__subcmd__ood"
+                ;;
             mo__metrics__subcmd__help,physics)
                 cmd="mo__metrics__subcmd__help__subcmd__physics"
                 ;;
@@ -59,7 +65,7 @@ _mo__metrics() {
 
     case "${cmd}" in
         mo__metrics)
-            opts="-o -q -v -h -V --format --skeleton --from --output --seed --quiet --verbose --threads --help --version generation transfer reconstruction aggregate physics help"
+            opts="-o -q -v -h -V --format --skeleton --from --output --seed --quiet --verbose --threads --help --version ood generation transfer reconstruction aggregate physics help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -205,7 +211,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__help)
-            opts="generation transfer reconstruction aggregate physics help"
+            opts="ood generation transfer reconstruction aggregate physics help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -260,6 +266,20 @@ _mo__metrics() {
             COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
             return 0
             ;;
+        mo__subcmd__metrics__subcmd__help__subcmd__ood)
+            opts=""
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
         mo__subcmd__metrics__subcmd__help__subcmd__physics)
             opts=""
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 3 ]] ; then
@@ -295,6 +315,52 @@ _mo__metrics() {
                 return 0
             fi
             case "${prev}" in
+                *)
+                    COMPREPLY=()
+                    ;;
+            esac
+            COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+            return 0
+            ;;
+        mo__subcmd__metrics__subcmd__ood)
+            opts="-o -q -v -h --model --latent --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
+                COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
+                return 0
+            fi
+            case "${prev}" in
+                --model)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --format)
+                    COMPREPLY=($(compgen -W "json table" -- "${cur}"))
+                    return 0
+                    ;;
+                --skeleton)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --from)
+                    COMPREPLY=($(compgen -W "rotations positions" -- "${cur}"))
+                    return 0
+                    ;;
+                --output)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                -o)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --seed)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 *)
                     COMPREPLY=()
                     ;;

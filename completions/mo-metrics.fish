@@ -36,12 +36,26 @@ complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s q -l quiet -d 'Pr
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s V -l version -d 'Print version'
+complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "ood" -d 'How far skeletons lie from a learned model\'s training skeletons (the out-of-distribution score behind the warning of mo-sample, mo-dift, mo-segment, mo-encode --latent and mo-retarget --method latent)'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "generation" -d 'AnyTop\'s generation metrics: generated samples against ground-truth clips of one skeleton'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "transfer" -d 'Motion2Motion\'s transfer metrics: results against their source and the target\'s examples'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "reconstruction" -d 'SATA\'s reconstruction metrics: a result against a reference motion on the same skeleton'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "aggregate" -d 'The paper\'s table row: mean and std over skeletons of per-skeleton generation results'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "physics" -d 'Physical plausibility of any motion: foot skating, ground penetration, floating, jitter'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l model -d 'Model directory [default: the built-in diffusion model, or with --latent the built-in latent model]' -r -F
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l format -d 'Output format' -r -f -a "json\t''
+table\t''"
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l skeleton -d 'Skeleton of NPY inputs: a skeleton document (skel-info) or a BVH file' -r -F
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l from -d 'AnyTop features: pose from their rotations or (generated clips) their positions by IK' -r -f -a "rotations\t'The features\' 6D rotations: exact for encoded features'
+positions\t'The features\' joint positions, by inverse kinematics: for generated features'"
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l latent -d 'Score against a latent model (SATA: mo-encode --latent, mo-retarget --method latent)'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s q -l quiet -d 'Print nothing on stderr but errors'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s v -l verbose -d 'Print more about what is happening on stderr'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l gt -d 'Ground-truth clips (files or directories)' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l gen -d 'Generated samples (files or directories; an NPY batch gives one sample per row)' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l window -d 'Window length of coverage and local diversity, in frames' -r
@@ -114,9 +128,10 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l thread
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s h -l help -d 'Print help (see more with \'--help\')'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "generation" -d 'AnyTop\'s generation metrics: generated samples against ground-truth clips of one skeleton'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "transfer" -d 'Motion2Motion\'s transfer metrics: results against their source and the target\'s examples'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "reconstruction" -d 'SATA\'s reconstruction metrics: a result against a reference motion on the same skeleton'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "aggregate" -d 'The paper\'s table row: mean and std over skeletons of per-skeleton generation results'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "physics" -d 'Physical plausibility of any motion: foot skating, ground penetration, floating, jitter'
-complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from generation transfer reconstruction aggregate physics help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from ood generation transfer reconstruction aggregate physics help" -f -a "ood" -d 'How far skeletons lie from a learned model\'s training skeletons (the out-of-distribution score behind the warning of mo-sample, mo-dift, mo-segment, mo-encode --latent and mo-retarget --method latent)'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from ood generation transfer reconstruction aggregate physics help" -f -a "generation" -d 'AnyTop\'s generation metrics: generated samples against ground-truth clips of one skeleton'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from ood generation transfer reconstruction aggregate physics help" -f -a "transfer" -d 'Motion2Motion\'s transfer metrics: results against their source and the target\'s examples'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from ood generation transfer reconstruction aggregate physics help" -f -a "reconstruction" -d 'SATA\'s reconstruction metrics: a result against a reference motion on the same skeleton'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from ood generation transfer reconstruction aggregate physics help" -f -a "aggregate" -d 'The paper\'s table row: mean and std over skeletons of per-skeleton generation results'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from ood generation transfer reconstruction aggregate physics help" -f -a "physics" -d 'Physical plausibility of any motion: foot skating, ground penetration, floating, jitter'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand help; and not __fish_seen_subcommand_from ood generation transfer reconstruction aggregate physics help" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'

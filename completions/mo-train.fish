@@ -2,17 +2,19 @@ complete -c mo-train -l out -d 'Model directory to write (and to resume from)' -
 complete -c mo-train -l preset -d 'Model size: tiny, small or paper (width 128, 4 layers, 4 heads)' -r -f -a "tiny\t''
 small\t''
 paper\t''"
-complete -c mo-train -l steps -d 'Training steps in total (a resumed run counts the steps already done)' -r
+complete -c mo-train -l steps -d 'Training steps in total (a resumed run counts the steps already done) [default: 10000, or no limit with --minutes]' -r
+complete -c mo-train -l minutes -d 'Train for this much wall time (this invocation\'s), then save and stop; with --steps, whichever comes first. The progress bar then shows the time left' -r
+complete -c mo-train -l init -d 'anytop: start from a trained model instead of random weights: \'builtin\' (the model inside the binaries) or a model directory written by mo-train (use ./builtin for a directory of that name). A new run only: with --resume the checkpoint in --out goes on' -r -F
 complete -c mo-train -l batch -d 'Crops per step' -r
 complete -c mo-train -l crop -d 'Crop length in frames (default 40 for anytop; for sata the preset\'s window, 32 for small, which then is also the model\'s inference window)' -r
 complete -c mo-train -l arch -d 'What to train: anytop (the diffusion model behind mo-sample, mo-dift and mo-segment) or sata (the topology-agnostic autoencoder behind mo-encode --latent and mo-retarget --method latent)' -r -f -a "anytop\t''
 sata\t''"
 complete -c mo-train -l lambda-kl -d 'sata: weight of the KL term that keeps the latent near a unit Gaussian' -r
 complete -c mo-train -l lambda-cycle -d 'sata: weight of the cross-skeleton latent cycle (a motion\'s latent decoded onto another training skeleton and encoded again should come back). Default 0 for a new run (tried at 1 for 1,100 steps: transfers moved less, models/zoo-sata/MODEL_CARD.md); a resumed run keeps its checkpoint\'s unless this is given' -r
-complete -c mo-train -l lr -d 'Learning rate' -r
+complete -c mo-train -l lr -d 'Learning rate [default: 1e-4; with --init 3e-4]' -r
 complete -c mo-train -l lambda-geo -d 'Weight of the geodesic rotation loss (the angle, in radians, between predicted and true joint rotations) next to the MSE; the reference trains with 1' -r
 complete -c mo-train -l lambda-vel -d 'Weight of a velocity loss next to the MSE: the squared error of the prediction\'s frame-to-frame changes against the motion\'s (normalised units; MDM\'s, not in AnyTop\'s reference). 0 = off. Not kept in the checkpoint: give it again with --resume' -r
-complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3' -r
+complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3 [default: 2/3; with --init 0]' -r
 complete -c mo-train -l augment-variants -d 'Augmented variants prepared per skeleton (alternately removing and adding joints)' -r
 complete -c mo-train -l ema -d 'anytop: decay of the moving average of the weights that the saved model holds and mo-sample samples with (the raw weights are kept beside it for --resume). 0 = save the raw weights. An average over about 1/(1 - decay) steps' -r
 complete -c mo-train -l noise-shift -d 'anytop: divide the cosine noise schedule\'s signal-to-noise ratio by S² at every step, so the slow, whole-crop directions of motion are drowned in noise early enough for sampling to choose a motion over many steps instead of settling on the mean pose in the first. 1 = AnyTop\'s schedule [default: 10 for a new run (3-skeleton proxy: samples\' motion energy 0.2 of the clips\' at 1, 0.4-0.6 at 10); a resumed run keeps its checkpoint\'s, unless this is given: then the model goes on learning under the new schedule]' -r

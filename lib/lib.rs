@@ -20,6 +20,7 @@
 //! * [`document`]: the skeleton document (JSON) `skel-info` prints and the tools read.
 //! * [`embed`]: joint-name text embeddings, offline (a built-in MiniLM table).
 //! * [`binding`]: bone bindings between two skeletons, from a file or automatic.
+//! * [`ood`]: how far a skeleton lies from a model's training skeletons (the OOD warning).
 //! * [`augment`]: skeletal augmentation (remove chains, subdivide bones), motion kept exact.
 //!
 //! Algorithms:
@@ -54,6 +55,7 @@ pub mod linalg;
 pub mod metrics;
 pub mod motion;
 pub mod nn;
+pub mod ood;
 pub(crate) mod patch;
 pub mod render;
 pub mod repr;

@@ -112,10 +112,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (false, n) => bail!("features are written for one motion; {n} given (use --joints or --frames to compare two)"),
     }
     let device = Device::Cpu;
-    let model = match &args.model {
-        Some(dir) => checkpoint::frozen(dir, &device)?,
-        None => checkpoint::frozen_default(&device)?,
-    };
+    let model = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
     let defaults = if args.joints { DiftOptions::SPATIAL } else { DiftOptions::TEMPORAL };
     let opts = DiftOptions {
         t: args.t.unwrap_or(defaults.t),
@@ -127,6 +124,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let motions = load_motions(&inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
     if motions.len() != inputs.len() {
         bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
+    }
+    for m in &motions {
+        super::ood::warn_denoiser("mo-dift", &m.name, args.model.as_deref(), &model.info, &m.skeleton, args.common.quiet)?;
     }
     let features: Vec<DiftFeatures> = motions.iter().map(|m| features_of(&model, m, &opts, &device)).collect::<anyhow::Result<_>>()?;
     let bytes = if !pairwise {

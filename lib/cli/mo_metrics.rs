@@ -26,7 +26,8 @@ EXAMPLES:
     mo-metrics reconstruction --reference examples/data/dragon.bvh --result examples/data/dragon.bvh
     mo-metrics transfer --source examples/data/biped.bvh --result examples/data/biped.bvh
     mo-metrics generation --gt examples/data/quadruped.bvh --gen examples/data/quadruped.bvh
-    mo-encode examples/data/crab.bvh | mo-metrics physics - --skeleton examples/data/crab.bvh";
+    mo-encode examples/data/crab.bvh | mo-metrics physics - --skeleton examples/data/crab.bvh
+    mo-metrics ood examples/data/dragon.bvh examples/data/crab.bvh --format table";
 
 /// Score motion: generation, transfer, reconstruction and physical-plausibility metrics.
 ///
@@ -76,6 +77,27 @@ pub enum Format {
 
 #[derive(clap::Subcommand, Debug)]
 pub enum Command {
+    /// How far skeletons lie from a learned model's training skeletons (the out-of-distribution
+    /// score behind the warning of mo-sample, mo-dift, mo-segment, mo-encode --latent and
+    /// mo-retarget --method latent).
+    ///
+    /// Per skeleton: the score (the distance to the nearest training skeleton: graph, rest
+    /// proportions and joint names, each about 0 for the same skeleton and 1 for unrelated
+    /// ones), whether it is in range (score <= limit), the nearest training skeleton and the
+    /// parts of the distance. With --verbose also each training skeleton's nearest other one.
+    /// Definitions and the calibration of the limit: docs/ood.md.
+    Ood {
+        /// Skeletons: BVH files or skeleton documents.
+        #[arg(value_name = "SKELETON", required = true, num_args = 1..)]
+        skeletons: Vec<PathBuf>,
+        /// Model directory [default: the built-in diffusion model, or with --latent the
+        /// built-in latent model].
+        #[arg(long, value_name = "DIR")]
+        model: Option<PathBuf>,
+        /// Score against a latent model (SATA: mo-encode --latent, mo-retarget --method latent).
+        #[arg(long)]
+        latent: bool,
+    },
     /// AnyTop's generation metrics: generated samples against ground-truth clips of one skeleton.
     ///
     /// Features per frame: the positions of joints 1..J-1 relative to the root (x, z
@@ -238,6 +260,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             run_transfer(args, source, result, binding.as_deref(), examples, *seconds, *fid_window)?
         }
         Command::Aggregate { reports } => run_aggregate(reports)?,
+        Command::Ood { skeletons, model, latent } => run_ood(args, skeletons, model.as_deref(), *latent)?,
         Command::Generation { gt, generated, window, threshold, min_segment } => {
             let opts =
                 GenerationOptions { window: *window, threshold: *threshold, min_segment: *min_segment, seed: args.common.seed, ..GenerationOptions::default() };
@@ -252,6 +275,33 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Format::Table => table(&report),
     };
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
+}
+
+fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: bool) -> anyhow::Result<Value> {
+    let device = candle_core::Device::Cpu;
+    let (reference, label) = if latent {
+        let m = super::latent::load_model(model, &device)?;
+        (super::ood::latent_reference(&m.rigs)?, super::ood::model_label(model, "the built-in latent model"))
+    } else {
+        let m = crate::diffusion::checkpoint::frozen_or_default(model, &device)?;
+        (super::ood::denoiser_reference(&m.info)?, super::ood::model_label(model, crate::diffusion::checkpoint::BUILTIN_NAME))
+    };
+    if reference.profiles.is_empty() {
+        bail!("{label} records no training skeletons to compare with");
+    }
+    let table = crate::embed::NameTable::builtin()?;
+    let mut scored = Vec::new();
+    for path in skeletons {
+        let arg = read_skeleton(path)?;
+        let score = reference.score(&crate::ood::Profile::of_skeleton(&arg.name, &arg.skeleton, table));
+        scored.push(json!({ "skeleton": arg.name, "ood": score }));
+    }
+    let mut report = json!({ "model": label, "limit": crate::ood::LIMIT, "skeletons": scored });
+    if args.common.verbose {
+        let within: Vec<Value> = reference.nearest_within().into_iter().map(|(a, b, d)| json!({ "skeleton": a, "nearest": b, "distance": d })).collect();
+        report["training"] = Value::Array(within);
+    }
+    Ok(report)
 }
 
 fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -> anyhow::Result<PhysicsOptions> {

@@ -28,7 +28,8 @@ EXAMPLES:
     mo-sample --reference q.bvh --model model --steps 5 --keep-joints '*Thigh/' --bvh legs.bvh
     mo-sample --examples examples/data/dragon.bvh -n 2 --frames 200 --bvh 'gen_{i}.bvh'
     mo-sample examples/data/crab.bvh --examples examples/data/crab.bvh --seconds 10 > crab.npy
-    mo-sample --examples gen_0.bvh --reference gen_1.bvh --keep-frames 0-29,170-199 > ib.npy";
+    mo-sample --examples gen_0.bvh --reference gen_1.bvh --keep-frames 0-29,170-199 > ib.npy
+    mo-sample examples/data/dragon.bvh --model my_dragon -n 2 --frames 60 --bvh 'my_dragon_{i}.bvh'";
 
 /// The default `--smooth`: 7 Hz, the lowest whole cutoff at which the post-process keeps real
 /// motion: on the bundled creatures and real clips (dog, chicken, flamingo, monkey, crab, a
@@ -45,6 +46,11 @@ pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 
 /// Generate motion for a skeleton with a trained diffusion model (AnyTop), or from a few clips
 /// of it with no model at all (--examples, GenMM).
+///
+/// Your own creature, three ways: the built-in model as it is (any skeleton, no clips; best on
+/// creatures like its synthetic zoo); --examples with a clip or more of it (no training, new
+/// motion made of the clips' own pieces); or a model fine-tuned on its clips in a few minutes
+/// (`mo-train CLIPS --init builtin --minutes 5 --out DIR`, then --model DIR).
 ///
 /// SKELETON is a skeleton document (skel-info's JSON, also on stdin) or a BVH file. The model
 /// needs only the skeleton's topology, rest pose and joint names, so skeletons never seen in
@@ -92,7 +98,8 @@ pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 /// fine over a pyramid in time: the coarsest level starts as a seeded random walk through the
 /// clips' coarse patches (jumping between similar places), and every level replaces each patch
 /// (11 frames) by its nearest clip patch and averages the overlaps; the root's turning is kept
-/// as a rate, so stitched stretches turn smoothly. Two 200-frame samples take about 0.1 s. Any
+/// as a rate, so stitched stretches turn smoothly. Two 200-frame samples take 0.04-0.44 s,
+/// growing with the clips' length and joint count (benches/genmm_cli.sh). Any
 /// length (default: the longest clip's; --frames, --seconds), -n samples with seeds --seed,
 /// --seed+1, ... (the same seed gives the same bytes); BVH on the clips' skeleton with --bvh,
 /// else NPY [n, frames, joints, 9] of Motion2Motion features (decode with mo-encode --repr m2m
@@ -201,11 +208,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let arg = read_skeleton(args.skeleton.as_ref().or(args.skeleton_option.as_ref()).or(args.reference.as_ref()).unwrap_or(&dash))?;
     let skeleton = &arg.skeleton;
     let device = Device::Cpu;
-    let loaded = match &args.model {
-        Some(dir) => checkpoint::frozen(dir, &device)?,
-        None => checkpoint::frozen_default(&device)?,
-    };
+    let loaded = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
     let section = arg.record()?;
+    super::ood::warn_denoiser("mo-sample", &arg.name, args.model.as_deref(), &loaded.info, skeleton, args.common.quiet)?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     let reference = match &args.reference {
         Some(path) => {

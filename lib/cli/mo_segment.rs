@@ -185,11 +185,11 @@ pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>
         Features::Raw => raw_features(input),
         Features::Dift => {
             let device = candle_core::Device::Cpu;
-            let model = match &args.model {
-                Some(dir) => checkpoint::frozen(dir, &device)?,
-                None => checkpoint::frozen_default(&device)?,
-            };
+            let model = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
             let opts = DiftOptions { t: args.t, layer: args.layer, draws: args.draws as usize, seed: args.common.seed, ..DiftOptions::TEMPORAL };
+            if let Some((skeleton, _)) = &input.skeleton {
+                super::ood::warn_denoiser("mo-segment", &input.name, args.model.as_deref(), &model.info, skeleton, args.common.quiet)?;
+            }
             dift_features(&model, input, &opts)
         }
     }

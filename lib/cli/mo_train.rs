@@ -23,10 +23,7 @@ EXAMPLES:
     mo-train examples/data --out model --preset tiny --steps 3 --batch 2 --crop 16
     mo-train examples/data --out model --preset tiny --steps 5 --batch 2 --crop 16 --resume
     mo-train examples/data --out model2 --preset tiny --steps 3 --batch 2 --crop 16 --augment 0
-
-  Your own creature: fine-tune the built-in model on its clips for 5 minutes, then sample it
-    mo-train my_creature/ --init builtin --minutes 5 --out my_model
-    mo-sample my_creature/walk.bvh --model my_model -n 4 --bvh 'new_{}.bvh'";
+    mo-train examples/data/dragon.bvh --init builtin --minutes 0.1 --out my_dragon";
 
 /// Train the diffusion model (AnyTop's denoiser) on BVH clips of any skeletons.
 ///

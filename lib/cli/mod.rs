@@ -19,6 +19,7 @@ pub mod mo_sample;
 pub mod mo_sample_examples;
 pub mod mo_segment;
 pub mod mo_train;
+pub mod ood;
 pub mod skel_aug;
 pub mod skel_info;
 

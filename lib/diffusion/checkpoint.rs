@@ -279,6 +279,14 @@ pub fn frozen_default(device: &Device) -> Result<Frozen, CheckpointError> {
     frozen_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))
 }
 
+/// `--model DIR`'s model, or the built-in one.
+pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<Frozen, CheckpointError> {
+    match dir {
+        Some(dir) => frozen(dir, device),
+        None => frozen_default(device),
+    }
+}
+
 /// The built-in model's `checkpoint.json` and `model.safetensors`, embedded in the binaries.
 pub const BUILTIN_INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
 pub const BUILTIN_WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");

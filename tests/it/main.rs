@@ -26,6 +26,7 @@ mod mo_train_cli;
 mod mo_train_sample_cli;
 mod name_embeddings;
 mod npy;
+mod ood;
 mod post_process;
 mod render_html;
 mod skel_aug;
