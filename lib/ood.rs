@@ -248,6 +248,8 @@ mod tests {
         let offsets: Vec<DVec3> = (0..41).map(|i| DVec3::new((i as f64).cos(), (i as f64).sin(), 0.1 * i as f64)).collect();
         let star = reference.score(&Profile::new("star", &names, &parents, &offsets, table)).unwrap();
         assert!(!star.in_range && star.score > 2.0 * LIMIT, "{star:?}");
-        assert!(warning("mo-sample", "star", "the built-in model", &star, "use --examples").is_some_and(|w| w.contains("out of") && w.ends_with("use --examples")));
+        assert!(
+            warning("mo-sample", "star", "the built-in model", &star, "use --examples").is_some_and(|w| w.contains("out of") && w.ends_with("use --examples"))
+        );
     }
 }

@@ -319,7 +319,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
                 }
                 if let Some((old, new)) = resume.shift_changes(&opts) {
-                    say(args, &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
+                    say(
+                        args,
+                        &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"),
+                    );
                 }
                 AnyTopStart::Resume(resume)
             } else if let Some(init) = &args.init {

@@ -23,8 +23,11 @@ pub fn denoiser_reference(info: &CheckpointInfo) -> anyhow::Result<Reference> {
 /// The latent model's training skeletons (its `rigs.json`).
 pub fn latent_reference(rigs: &KnownRigs) -> anyhow::Result<Reference> {
     let table = NameTable::builtin()?;
-    let profiles =
-        rigs.rigs.iter().map(|r| Profile::new(&r.name, &r.joints, &r.parents, &r.offsets.iter().map(|o| DVec3::from_array(*o)).collect::<Vec<_>>(), table)).collect();
+    let profiles = rigs
+        .rigs
+        .iter()
+        .map(|r| Profile::new(&r.name, &r.joints, &r.parents, &r.offsets.iter().map(|o| DVec3::from_array(*o)).collect::<Vec<_>>(), table))
+        .collect();
     Ok(Reference { profiles })
 }
 
@@ -50,7 +53,9 @@ fn advice(tool: &str) -> &'static str {
     match tool {
         "mo-sample" => "use --examples CLIPS (no model), or fine-tune on its clips: mo-train CLIPS --init builtin --minutes 5 --out DIR, then --model DIR",
         "mo-segment" => "use --features raw, or fine-tune on its clips: mo-train CLIPS --init builtin --minutes 5 --out DIR, then --model DIR",
-        "mo-retarget" => "use the default method (Motion2Motion, from example clips of the target), or train a latent model on both skeletons' clips: mo-train --arch sata",
+        "mo-retarget" => {
+            "use the default method (Motion2Motion, from example clips of the target), or train a latent model on both skeletons' clips: mo-train --arch sata"
+        }
         "mo-encode" => "train a latent model on its clips: mo-train CLIPS --arch sata --out DIR, then --model DIR",
         _ => "fine-tune on its clips: mo-train CLIPS --init builtin --minutes 5 --out DIR, then --model DIR",
     }

@@ -216,7 +216,11 @@ fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
     args.extend(["--lr", "1e-30", "--ema", "0"]);
     let out = run("mo-train", &args, None);
     ok(&out, "init from dir");
-    assert!(String::from_utf8_lossy(&out.stderr).contains(&format!("fine-tuning model {} (step 3)", base.display())), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains(&format!("fine-tuning model {} (step 3)", base.display())),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let (b, t) = (info(&base), info(&tuned));
     assert_eq!((&t["config"], t["noise_shift"].as_f64(), t["step"].as_u64()), (&b["config"], Some(4.0), Some(1)));
     assert_eq!(t["init"].as_str(), Some(format!("model {} (step 3)", base.display()).as_str()));
