@@ -195,6 +195,14 @@ fn invalid_inputs_are_refused() {
     };
 
     let huge = write("huge.bvh", bvh_with_root_x("1e300").as_bytes());
+    // A bundled quadruped with its first frame's root at x = 1e300: its bones cannot be
+    // measured from that rest pose (the message used to blame a damaged rig).
+    let quadruped = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/quadruped.bvh")).unwrap();
+    let (head, frames) = quadruped.split_once("Frame Time:").unwrap();
+    let (time, rows) = frames.split_once('\n').unwrap();
+    let (first, rest) = rows.split_once('\n').unwrap();
+    let first = std::iter::once("1e300").chain(first.split_whitespace().skip(1)).collect::<Vec<_>>().join(" ");
+    let huge_rig = write("huge_rig.bvh", format!("{head}Frame Time:{time}\n{first}\n{rest}").as_bytes());
     let good = write("good.bvh", bvh_with_root_x("0").as_bytes());
     let no_frames = bvh_with_root_x("0");
     let no_frames = no_frames[..no_frames.find("Frames: 3").unwrap()].to_string() + "Frames: 0\nFrame Time: 0.0333333\n";
@@ -241,6 +249,8 @@ fn invalid_inputs_are_refused() {
 
     let cases = vec![
         case("1e300 in a BVH", "mo-encode", &[s(&huge), "-q", "-o", o], &["huge.bvh", "too large"]).absent(&[&out]),
+        case("1e300 as a rest-frame position of a real rig", "mo-encode", &[s(&huge_rig), "-q", "-o", o], &["huge_rig.bvh", "joint 0", "too large"])
+            .absent(&[&out]),
         case("1e300 in a BVH, m2m", "mo-encode", &[s(&huge), "-q", "--repr", "m2m", "-o", o], &["huge.bvh", "too large"]).absent(&[&out]),
         case("placement too large", "mo-encode", &[s(&encoded), "--decode", "--skeleton", b, "--placement", s(&placement), "-o", s(&bvh_out)], &["non-finite"])
             .absent(&[&bvh_out]),

@@ -279,6 +279,9 @@ pub enum AnyTopError {
     Dims(usize),
     #[error("the rest motion has no frames")]
     EmptyRest,
+    /// A rest-frame position so far out that bones cannot be measured from it in f64.
+    #[error("rest frame: joint {joint} '{name}' is placed at {value:e}: too large to measure bones from (more than 1e9 mean bone lengths out)")]
+    RestOutOfRange { joint: usize, name: String, value: f64 },
     #[error("the skeleton has no bones (all OFFSETs are zero): no scale factor")]
     NoBones,
     #[error("{what} names joint {joint}, but the skeleton has {joints} joints")]

@@ -145,7 +145,15 @@ impl AnyTopRig {
         if rest.frames == 0 {
             return Err(AnyTopError::EmptyRest);
         }
-        let scale = HUMANML_MEAN_BONE_LENGTH / mean_offset_length(skeleton)?;
+        let mean_bone = mean_offset_length(skeleton)?;
+        let scale = HUMANML_MEAN_BONE_LENGTH / mean_bone;
+        // f64 keeps about 16 digits: a bone measured from positions 1e9 bones out keeps ~7.
+        for (j, t) in rest.translations.iter().take(n).enumerate() {
+            let value = t.abs().max_element();
+            if !(value <= 1e9 * mean_bone) {
+                return Err(AnyTopError::RestOutOfRange { joint: j, name: skeleton.joints[j].name.clone(), value });
+            }
+        }
 
         let world = rest.forward_kinematics(skeleton);
         let p0 = world.frame_positions(0);
