@@ -30,7 +30,6 @@ pub const LIMIT: f64 = 0.25;
 #[derive(Clone, Debug)]
 pub struct Profile {
     pub name: String,
-    joints: usize,
     /// Per joint, each sorted: depth, child count, height above the deepest leaf below.
     graph: [Vec<f64>; 3],
     /// Per non-root joint, sorted: bone length and rest distance from the root, over the size.
@@ -68,7 +67,6 @@ impl Profile {
         };
         Profile {
             name: name.to_string(),
-            joints: n,
             graph: [
                 sorted(depth.iter().map(|&d| d as f64).collect()),
                 sorted(children.iter().map(|&c| c as f64).collect()),
@@ -136,7 +134,8 @@ fn name_match(a: &[Vec<f32>], b: &[Vec<f32>]) -> f64 {
 
 pub fn distance(a: &Profile, b: &Profile) -> Distance {
     let relative = |x: &[f64], y: &[f64]| wasserstein(x, y) / mean(x).max(mean(y)).max(1.0);
-    let count = ((a.joints.max(1) as f64) / (b.joints.max(1) as f64)).ln().abs();
+    let joints = |p: &Profile| p.graph[0].len().max(1) as f64;
+    let count = (joints(a) / joints(b)).ln().abs();
     let graph = (relative(&a.graph[0], &b.graph[0]) + wasserstein(&a.graph[1], &b.graph[1]) + relative(&a.graph[2], &b.graph[2]) + count) / 4.0;
     // Both shape samples lie in [0, 1]; a distance of 0.25 is already a very different body.
     let proportions = 2.0 * (wasserstein(&a.shape[0], &b.shape[0]) + wasserstein(&a.shape[1], &b.shape[1]));

@@ -125,8 +125,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if motions.len() != inputs.len() {
         bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
     }
+    let known = super::ood::Known::denoiser(args.model.as_deref(), &model.info)?;
     for m in &motions {
-        super::ood::warn_denoiser("mo-dift", &m.name, args.model.as_deref(), &model.info, &m.skeleton, args.common.quiet)?;
+        known.warn("mo-dift", &m.name, &m.skeleton, args.common.quiet)?;
     }
     let features: Vec<DiftFeatures> = motions.iter().map(|m| features_of(&model, m, &opts, &device)).collect::<anyhow::Result<_>>()?;
     let bytes = if !pairwise {

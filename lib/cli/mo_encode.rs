@@ -264,7 +264,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
     let bytes = if args.latent {
         let [input] = args.inputs.as_slice() else { bail!("--latent encodes one BVH clip, {} given", args.inputs.len()) };
         let clip = super::latent::read_source(input, &model, &device)?;
-        super::ood::warn_latent("mo-encode", &clip.name, args.model.as_deref(), &model.rigs, &clip.skeleton, args.common.quiet)?;
+        super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &clip.name, &clip.skeleton, args.common.quiet)?;
         let latents = super::latent::encode(&model, &clip, &device)?;
         io::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
         super::latent::latents_npy(&latents)?
@@ -277,7 +277,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         let latents = super::latent::read_latents(&input)?;
         let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
         let target = super::latent::read_target(skeleton, &model, &device)?;
-        super::ood::warn_latent("mo-encode", &target.arg.name, args.model.as_deref(), &model.rigs, &target.arg.skeleton, args.common.quiet)?;
+        super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.arg.name, &target.arg.skeleton, args.common.quiet)?;
         let frame_time = target.arg.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
         super::latent::decode_bvh(&model, &latents, &target, frame_time, &device)?.into_bytes()
     };

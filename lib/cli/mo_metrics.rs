@@ -279,26 +279,22 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: bool) -> anyhow::Result<Value> {
     let device = candle_core::Device::Cpu;
-    let (reference, label) = if latent {
-        let m = super::latent::load_model(model, &device)?;
-        (super::ood::latent_reference(&m.rigs)?, super::ood::model_label(model, "the built-in latent model"))
+    let known = if latent {
+        super::ood::Known::latent(model, &super::latent::load_model(model, &device)?.rigs)?
     } else {
-        let m = crate::diffusion::checkpoint::frozen_or_default(model, &device)?;
-        (super::ood::denoiser_reference(&m.info)?, super::ood::model_label(model, crate::diffusion::checkpoint::BUILTIN_NAME))
+        super::ood::Known::denoiser(model, &crate::diffusion::checkpoint::frozen_or_default(model, &device)?.info)?
     };
-    if reference.profiles.is_empty() {
-        bail!("{label} records no training skeletons to compare with");
+    if known.reference.profiles.is_empty() {
+        bail!("{} records no training skeletons to compare with", known.model);
     }
-    let table = crate::embed::NameTable::builtin()?;
     let mut scored = Vec::new();
     for path in skeletons {
         let arg = read_skeleton(path)?;
-        let score = reference.score(&crate::ood::Profile::of_skeleton(&arg.name, &arg.skeleton, table));
-        scored.push(json!({ "skeleton": arg.name, "ood": score }));
+        scored.push(json!({ "skeleton": arg.name, "ood": known.score(&arg.name, &arg.skeleton)? }));
     }
-    let mut report = json!({ "model": label, "limit": crate::ood::LIMIT, "skeletons": scored });
+    let mut report = json!({ "model": known.model, "limit": crate::ood::LIMIT, "skeletons": scored });
     if args.common.verbose {
-        let within: Vec<Value> = reference.nearest_within().into_iter().map(|(a, b, d)| json!({ "skeleton": a, "nearest": b, "distance": d })).collect();
+        let within: Vec<Value> = known.reference.nearest_within().into_iter().map(|(a, b, d)| json!({ "skeleton": a, "nearest": b, "distance": d })).collect();
         report["training"] = Value::Array(within);
     }
     Ok(report)

@@ -201,8 +201,9 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     let model = super::latent::load_model(args.model.as_deref(), &device)?;
     let source = super::latent::read_source(&args.source, &model, &device)?;
     let target = super::latent::read_target(&target_path, &model, &device)?;
+    let known = super::ood::Known::latent(args.model.as_deref(), &model.rigs)?;
     for (name, skeleton) in [(&source.name, &source.skeleton), (&target.arg.name, &target.arg.skeleton)] {
-        super::ood::warn_latent("mo-retarget", name, args.model.as_deref(), &model.rigs, skeleton, args.common.quiet)?;
+        known.warn("mo-retarget", name, skeleton, args.common.quiet)?;
     }
     let latents = super::latent::encode(&model, &source, &device)?;
     let text = super::latent::decode_bvh(&model, &latents, &target, source.motion.frame_time, &device)?;

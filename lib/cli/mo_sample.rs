@@ -210,7 +210,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let device = Device::Cpu;
     let loaded = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
     let section = arg.record()?;
-    super::ood::warn_denoiser("mo-sample", &arg.name, args.model.as_deref(), &loaded.info, skeleton, args.common.quiet)?;
+    super::ood::Known::denoiser(args.model.as_deref(), &loaded.info)?.warn("mo-sample", &arg.name, skeleton, args.common.quiet)?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     let reference = match &args.reference {
         Some(path) => {

@@ -188,7 +188,7 @@ pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>
             let model = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
             let opts = DiftOptions { t: args.t, layer: args.layer, draws: args.draws as usize, seed: args.common.seed, ..DiftOptions::TEMPORAL };
             if let Some((skeleton, _)) = &input.skeleton {
-                super::ood::warn_denoiser("mo-segment", &input.name, args.model.as_deref(), &model.info, skeleton, args.common.quiet)?;
+                super::ood::Known::denoiser(args.model.as_deref(), &model.info)?.warn("mo-segment", &input.name, skeleton, args.common.quiet)?;
             }
             dift_features(&model, input, &opts)
         }

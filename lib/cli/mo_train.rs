@@ -311,6 +311,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 ema: args.ema,
                 noise_shift: args.noise_shift,
             };
+            // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.
+            refuse_to_overwrite(args)?;
             // The checkpoint first: a resumed run must rebuild the data (augmented variants
             // included) from the seed the run started with.
             let start = if args.resume {
@@ -326,7 +328,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 }
                 AnyTopStart::Resume(resume)
             } else if let Some(init) = &args.init {
-                refuse_to_overwrite(args)?;
                 let init = if init.as_os_str() == "builtin" { AnyTopInit::builtin(&device)? } else { AnyTopInit::load(init, &device)? };
                 say(args, &format!("fine-tuning {} (its size and noise schedule; --preset is not used)", init.source()));
                 AnyTopStart::Init(init)
@@ -337,7 +338,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 AnyTopStart::Resume(r) => r.info().seed,
                 _ => opts.seed,
             };
-            refuse_to_overwrite(args)?;
             let set = training_set(args, &resolved, seed, start.dmax())?;
             let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, &device).map_err(explain)?;
             train(args, &resolved, trainer.first_step(), &mut trainer)

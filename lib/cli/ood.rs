@@ -7,44 +7,61 @@ use crate::ood::{warning, Profile, Reference, Score};
 use crate::sata::rigs::KnownRigs;
 use crate::skeleton::Skeleton;
 use glam::DVec3;
+use std::path::Path;
 
-/// The diffusion model's training skeletons (as its checkpoint records them).
-pub fn denoiser_reference(info: &CheckpointInfo) -> anyhow::Result<Reference> {
-    let table = NameTable::builtin()?;
-    let profiles = info
-        .skeletons
-        .iter()
-        .filter(|t| t.offsets.len() == t.joints.len())
-        .map(|t| Profile::new(&t.name, &t.joints, &t.parents, &t.offsets.iter().map(|o| DVec3::from_array(*o)).collect::<Vec<_>>(), table))
-        .collect();
-    Ok(Reference { profiles })
+/// A model's training skeletons, profiled once per run, and how messages name the model.
+pub struct Known {
+    pub reference: Reference,
+    pub model: String,
 }
 
-/// The latent model's training skeletons (its `rigs.json`).
-pub fn latent_reference(rigs: &KnownRigs) -> anyhow::Result<Reference> {
-    let table = NameTable::builtin()?;
-    let profiles = rigs
-        .rigs
-        .iter()
-        .map(|r| Profile::new(&r.name, &r.joints, &r.parents, &r.offsets.iter().map(|o| DVec3::from_array(*o)).collect::<Vec<_>>(), table))
-        .collect();
-    Ok(Reference { profiles })
-}
+/// Name, joint names, parents and rest offsets of one recorded training skeleton.
+type Recorded<'a> = (&'a str, &'a [String], &'a [Option<usize>], &'a [[f64; 3]]);
 
-/// `skeleton`'s score against `reference`, with the warning (ending in `advice`) printed on
-/// stderr when it is out of range (unless `quiet`). None when the model records no skeletons.
-pub fn check(tool: &str, label: &str, model: &str, reference: &Reference, skeleton: &Skeleton, advice: &str, quiet: bool) -> anyhow::Result<Option<Score>> {
-    let score = reference.score(&Profile::of_skeleton(label, skeleton, NameTable::builtin()?));
-    if let Some(line) = score.as_ref().and_then(|s| warning(tool, label, model, s, advice)) {
-        if !quiet {
-            eprintln!("{line}");
-        }
+impl Known {
+    fn new<'a>(model: String, recorded: impl Iterator<Item = Recorded<'a>>) -> anyhow::Result<Known> {
+        let table = NameTable::builtin()?;
+        let profiles = recorded
+            .filter(|(_, joints, _, offsets)| offsets.len() == joints.len())
+            .map(|(name, joints, parents, offsets)| {
+                Profile::new(name, joints, parents, &offsets.iter().map(|o| DVec3::from_array(*o)).collect::<Vec<_>>(), table)
+            })
+            .collect();
+        Ok(Known { reference: Reference { profiles }, model })
     }
-    Ok(score)
+
+    /// The diffusion model's training skeletons (as its checkpoint records them); `dir` is the
+    /// model's directory, none for the built-in one.
+    pub fn denoiser(dir: Option<&Path>, info: &CheckpointInfo) -> anyhow::Result<Known> {
+        let model = model_label(dir, crate::diffusion::checkpoint::BUILTIN_NAME);
+        Known::new(model, info.skeletons.iter().map(|t| (t.name.as_str(), t.joints.as_slice(), t.parents.as_slice(), t.offsets.as_slice())))
+    }
+
+    /// The latent model's training skeletons (its `rigs.json`).
+    pub fn latent(dir: Option<&Path>, rigs: &KnownRigs) -> anyhow::Result<Known> {
+        let model = model_label(dir, "the built-in latent model");
+        Known::new(model, rigs.rigs.iter().map(|r| (r.name.as_str(), r.joints.as_slice(), r.parents.as_slice(), r.offsets.as_slice())))
+    }
+
+    /// `skeleton`'s score (None when the model records no skeletons).
+    pub fn score(&self, label: &str, skeleton: &Skeleton) -> anyhow::Result<Option<Score>> {
+        Ok(self.reference.score(&Profile::of_skeleton(label, skeleton, NameTable::builtin()?)))
+    }
+
+    /// Print `tool`'s warning for `skeleton` (named `label`) on stderr when it is out of range,
+    /// unless `quiet`.
+    pub fn warn(&self, tool: &str, label: &str, skeleton: &Skeleton, quiet: bool) -> anyhow::Result<()> {
+        if let Some(line) = self.score(label, skeleton)?.and_then(|s| warning(tool, label, &self.model, &s, advice(tool))) {
+            if !quiet {
+                eprintln!("{line}");
+            }
+        }
+        Ok(())
+    }
 }
 
 /// How warnings name a model: `model DIR` or the built-in one.
-pub fn model_label(dir: Option<&std::path::Path>, builtin: &str) -> String {
+fn model_label(dir: Option<&Path>, builtin: &str) -> String {
     dir.map_or_else(|| builtin.to_string(), |d| format!("model {}", d.display()))
 }
 
@@ -59,18 +76,4 @@ fn advice(tool: &str) -> &'static str {
         "mo-encode" => "train a latent model on its clips: mo-train CLIPS --arch sata --out DIR, then --model DIR",
         _ => "fine-tune on its clips: mo-train CLIPS --init builtin --minutes 5 --out DIR, then --model DIR",
     }
-}
-
-/// The warning for `skeleton` (named `label`) against a diffusion model (`dir`, or the
-/// built-in one).
-pub fn warn_denoiser(tool: &str, label: &str, dir: Option<&std::path::Path>, info: &CheckpointInfo, skeleton: &Skeleton, quiet: bool) -> anyhow::Result<()> {
-    let model = model_label(dir, crate::diffusion::checkpoint::BUILTIN_NAME);
-    check(tool, label, &model, &denoiser_reference(info)?, skeleton, advice(tool), quiet).map(drop)
-}
-
-/// The warning for `skeleton` (named `label`) against a latent model (`dir`, or the built-in
-/// one).
-pub fn warn_latent(tool: &str, label: &str, dir: Option<&std::path::Path>, rigs: &KnownRigs, skeleton: &Skeleton, quiet: bool) -> anyhow::Result<()> {
-    let model = model_label(dir, "the built-in latent model");
-    check(tool, label, &model, &latent_reference(rigs)?, skeleton, advice(tool), quiet).map(drop)
 }

@@ -246,11 +246,8 @@ fn horselink_name(part: Part, left: Option<bool>) -> String {
     match part {
         Part::Foot => format!("Bip01_{s}HorseLink"),
         Part::Toe => format!("Bip01_{s}Foot"),
-        Part::UpperArm => format!("Bip01_{s}UpperArm"),
-        Part::Forearm => format!("Bip01_{s}Forearm"),
-        Part::Forefoot => format!("Bip01_{s}Forefoot"),
-        Part::Foretoe => format!("Bip01_{s}Finger0"),
         Part::Wing(i) => format!("BN_Wing_{s}{:02}", i + 1),
+        // Arms, spine, tail and the rest are named as on a Biped.
         other => bip01_name(other, left),
     }
 }
