@@ -141,6 +141,13 @@ pub struct Args {
     /// unless this is given: then the model goes on learning under the new schedule].
     #[arg(long, value_name = "S", value_parser = bounds::positive(crate::diffusion::checkpoint::MAX_NOISE_SHIFT))]
     pub noise_shift: Option<f64>,
+    /// anytop: how the loss weighs the diffusion steps: `x0` (every step's x0 error alike,
+    /// AnyTop's), `v` (× 1 + SNR, the error of a v-prediction: the nearly clean steps count
+    /// more) or `min-snr[:G]` (× min(SNR, G), G = 5 by default: the noisy steps count by the
+    /// signal they carry) [default: x0 for a new run; a resumed run or a fine-tune keeps its
+    /// model's, unless this is given].
+    #[arg(long, value_name = "W")]
+    pub loss_weighting: Option<crate::diffusion::train::Weighting>,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
@@ -310,6 +317,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 augment_variants: args.augment_variants as usize,
                 ema: args.ema,
                 noise_shift: args.noise_shift,
+                weighting: args.loss_weighting,
             };
             // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.
             refuse_to_overwrite(args)?;

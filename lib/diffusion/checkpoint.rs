@@ -118,6 +118,10 @@ pub struct CheckpointInfo {
     /// before it existed.
     #[serde(default = "no_shift")]
     pub noise_shift: f64,
+    /// How the diffusion steps weighed in the loss (`train::Weighting`); x0 in checkpoints
+    /// written before it existed.
+    #[serde(default = "plain_x0", skip_serializing_if = "is_plain_x0")]
+    pub weighting: crate::diffusion::train::Weighting,
     /// The model a fine-tune started from (`mo-train --init`), as "the built-in default model
     /// (step N)" or "model DIR (step N)"; absent for a run from random weights.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -127,6 +131,14 @@ pub struct CheckpointInfo {
 
 fn no_shift() -> f64 {
     1.0
+}
+
+fn plain_x0() -> crate::diffusion::train::Weighting {
+    crate::diffusion::train::Weighting::X0
+}
+
+fn is_plain_x0(w: &crate::diffusion::train::Weighting) -> bool {
+    *w == crate::diffusion::train::Weighting::X0
 }
 
 impl CheckpointInfo {

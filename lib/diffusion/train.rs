@@ -201,6 +201,91 @@ pub struct StepStats {
     pub loss: f64,
 }
 
+/// What a training step's loss is made of (see `training_loss`): the weights of the rotation
+/// and velocity terms next to the MSE, and how the diffusion steps are weighed against each
+/// other.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LossTerms {
+    pub geo: f64,
+    pub vel: f64,
+    pub weighting: Weighting,
+}
+
+impl LossTerms {
+    /// The reference's: MSE + 1 × rotation, every diffusion step alike.
+    pub const REFERENCE: LossTerms = LossTerms { geo: 1.0, vel: 0.0, weighting: Weighting::X0 };
+}
+
+/// How much a crop's error counts, by the diffusion step it was noised to. The model predicts
+/// x0 and its error is always measured on x0; the weighting says what that error stands for.
+/// Weights are scaled to average 1 over the schedule's steps (drawn uniformly), so the loss
+/// keeps its size next to the rotation and velocity terms.
+///
+/// Why it matters here: under the shifted schedule (`Schedule::cosine_shifted`, shift 10)
+/// about half the steps have a signal-to-noise ratio below 0.01. There the best x0 is close to
+/// the mean pose and its error is large and irreducible, so with equal weights those steps
+/// dominate the loss and the gradient noise (issue 22: longer training made samples stiller).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Weighting {
+    /// Every step's x0 error alike: AnyTop's loss.
+    X0,
+    /// The error of a v-prediction (Salimans & Ho 2022): x0 error × (1 + SNR). Leaves the
+    /// noisy steps as they are and counts the nearly clean ones more.
+    V,
+    /// Min-SNR-γ (Hang et al. 2023) for x0: × min(SNR, γ). Counts the noisy steps by how much
+    /// signal they carry and caps the clean ones at γ.
+    MinSnr(f64),
+}
+
+impl Weighting {
+    /// The unscaled weight at signal-to-noise ratio `snr`.
+    fn raw(self, snr: f64) -> f64 {
+        match self {
+            Weighting::X0 => 1.0,
+            Weighting::V => 1.0 + snr,
+            Weighting::MinSnr(gamma) => snr.min(gamma),
+        }
+    }
+
+    /// The weight of every step of `schedule`, averaging 1.
+    pub fn weights(self, schedule: &Schedule) -> Vec<f64> {
+        let raw: Vec<f64> = schedule.alpha_bars.iter().map(|&ab| self.raw(ab / (1.0 - ab).max(f64::MIN_POSITIVE))).collect();
+        let mean = raw.iter().sum::<f64>() / raw.len().max(1) as f64;
+        raw.iter().map(|w| if mean > 0.0 { w / mean } else { 1.0 }).collect()
+    }
+}
+
+impl std::fmt::Display for Weighting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Weighting::X0 => write!(f, "x0"),
+            Weighting::V => write!(f, "v"),
+            Weighting::MinSnr(gamma) => write!(f, "min-snr:{gamma}"),
+        }
+    }
+}
+
+impl std::str::FromStr for Weighting {
+    type Err = String;
+
+    /// `x0`, `v`, `min-snr` (γ = 5, the paper's) or `min-snr:G`.
+    fn from_str(text: &str) -> Result<Weighting, String> {
+        match text.trim() {
+            "x0" => Ok(Weighting::X0),
+            "v" => Ok(Weighting::V),
+            "min-snr" => Ok(Weighting::MinSnr(5.0)),
+            other => {
+                let gamma = other.strip_prefix("min-snr:").ok_or_else(|| format!("'{text}' is not a weighting (expected x0, v, min-snr or min-snr:G)"))?;
+                match gamma.parse::<f64>() {
+                    Ok(g) if g.is_finite() && g > 0.0 && g <= 1e6 => Ok(Weighting::MinSnr(g)),
+                    _ => Err(format!("'{gamma}' is not a min-snr cap (expected a number above 0 and at most 1e6)")),
+                }
+            }
+        }
+    }
+}
+
 /// The crops of one skeleton (or augmented variant) in a step, in batch order, with their
 /// diffusion steps and the noise drawn for them: one sub-batch of the model.
 pub struct GroupDraw {
@@ -266,9 +351,9 @@ pub fn draw_step(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batc
 }
 
 /// The training loss of one batch: draw `batch` crops and timesteps, noise the motion (never
-/// the rest token), predict x0; loss = masked MSE (normalised space) + `lambda_geo` × the
+/// the rest token), predict x0; loss = masked MSE (normalised space) + `terms.geo` × the
 /// geodesic rotation distance of the 6D rotations (physical space), both over real joints and
-/// frames, as the reference (§3.3, λ_geo = 1 in its training commands); plus `lambda_vel` ×
+/// frames, as the reference (§3.3, λ_geo = 1 in its training commands); plus `terms.vel` ×
 /// the MSE of the frame-to-frame change of the prediction against the clean motion's (MDM's
 /// velocity loss, in normalised space over pairs of real frames). The velocity term is ours:
 /// the reference has none, and issue 22 measured that our undertrained model's x0 predictions
@@ -289,14 +374,13 @@ pub fn training_loss(
     rng: &mut SplitMix64,
     batch: usize,
     crop: usize,
-    lambda_geo: f64,
-    lambda_vel: f64,
+    terms: LossTerms,
     device: &Device,
 ) -> Result<Tensor, NnError> {
     let draw = draw_step(set, schedule, rng, batch, crop)?;
     let mut total: Option<LossSums> = None;
     for group in &draw.groups {
-        let part = loss_sums(model, set, group, lambda_geo != 0.0, lambda_vel != 0.0, schedule, device)?;
+        let part = loss_sums(model, set, group, terms, terms.vel != 0.0, schedule, device)?;
         total = Some(match total {
             None => part,
             Some(t) => LossSums {
@@ -316,11 +400,11 @@ pub fn training_loss(
     }
     let Some(sums) = total else { return Err(NnError::Shape { what: "training batch", expected: "at least one crop".into(), got: vec![0] }) };
     let mut loss = (sums.squared / sums.values.max(1.0))?;
-    if let Some(rotation) = sums.rotation.filter(|_| lambda_geo != 0.0) {
-        loss = (&loss + ((rotation / sums.tokens.max(1.0))? * lambda_geo)?)?;
+    if let Some(rotation) = sums.rotation.filter(|_| terms.geo != 0.0) {
+        loss = (&loss + ((rotation / sums.tokens.max(1.0))? * terms.geo)?)?;
     }
-    if let Some((velocity, values)) = sums.velocity.filter(|_| lambda_vel != 0.0) {
-        loss = (&loss + ((velocity / values.max(1.0))? * lambda_vel)?)?;
+    if let Some((velocity, values)) = sums.velocity.filter(|_| terms.vel != 0.0) {
+        loss = (&loss + ((velocity / values.max(1.0))? * terms.vel)?)?;
     }
     Ok(loss)
 }
@@ -341,21 +425,20 @@ pub fn step_gradients(
     set: &TrainSet,
     schedule: &Schedule,
     draw: &StepDraw,
-    lambda_geo: f64,
-    lambda_vel: f64,
+    terms: LossTerms,
     device: &Device,
 ) -> Result<(f64, Vec<GradStore>), NnError> {
     use rayon::prelude::*;
     let values = draw.tokens * draw.dims as f64;
-    let velocity_values = draw.velocity_values.filter(|_| lambda_vel != 0.0);
+    let velocity_values = draw.velocity_values.filter(|_| terms.vel != 0.0);
     let share = |group: &GroupDraw| -> Result<(f64, GradStore), NnError> {
-        let sums = loss_sums(model, set, group, lambda_geo != 0.0, velocity_values.is_some(), schedule, device)?;
+        let sums = loss_sums(model, set, group, terms, velocity_values.is_some(), schedule, device)?;
         let mut loss = (sums.squared / values.max(1.0))?;
         if let Some(rotation) = sums.rotation {
-            loss = (&loss + ((rotation / draw.tokens.max(1.0))? * lambda_geo)?)?;
+            loss = (&loss + ((rotation / draw.tokens.max(1.0))? * terms.geo)?)?;
         }
         if let (Some((velocity, _)), Some(count)) = (sums.velocity, velocity_values) {
-            loss = (&loss + ((velocity / count.max(1.0))? * lambda_vel)?)?;
+            loss = (&loss + ((velocity / count.max(1.0))? * terms.vel)?)?;
         }
         let value = loss.to_scalar::<f32>()? as f64;
         Ok((value, loss.backward()?))
@@ -418,7 +501,7 @@ fn loss_sums(
     model: &Denoiser,
     set: &TrainSet,
     group: &GroupDraw,
-    rotation: bool,
+    terms: LossTerms,
     velocity: bool,
     schedule: &Schedule,
     device: &Device,
@@ -456,21 +539,36 @@ fn loss_sums(
     let predicted = model.forward(&input)?;
     // Real motion tokens only: frames 1.. that exist, joints that exist.
     let mask = clean.frame_mask.reshape((b, t, 1, 1))?.broadcast_mul(&clean.joint_mask.reshape((b, 1, j, 1))?)?.broadcast_mul(&motion_token)?;
-    let squared = (&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask)?.sum_all()?;
     let tokens = mask.sum_all()?.to_scalar::<f32>()? as f64;
+    // The errors count by their crop's diffusion step; the normalisers stay plain counts.
+    let step_weight = match terms.weighting {
+        Weighting::X0 => None,
+        weighting => {
+            let all = weighting.weights(schedule);
+            let w: Vec<f32> = steps.iter().map(|&k| all[k as usize] as f32).collect();
+            Some(Tensor::from_vec(w, (b, 1, 1, 1), device)?)
+        }
+    };
+    let weighed = |x: Tensor| -> candle_core::Result<Tensor> {
+        match &step_weight {
+            Some(w) => x.broadcast_mul(w),
+            None => Ok(x),
+        }
+    };
+    let squared = weighed((&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask)?)?.sum_all()?;
     let values = tokens * d as f64;
     // Frame-to-frame changes of motion frames 1..t-1 (token 0 is the rest pose, never a
     // neighbour); a pair counts where both frames are real.
     let velocity = if velocity && t > 2 {
         let change = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(1, 2, t - 2)? - x.narrow(1, 1, t - 2)? };
         let pair_mask = (mask.narrow(1, 2, t - 2)? * mask.narrow(1, 1, t - 2)?)?;
-        let sum = (change(&predicted)? - change(&clean.x)?)?.sqr()?.broadcast_mul(&pair_mask)?.sum_all()?;
+        let sum = weighed((change(&predicted)? - change(&clean.x)?)?.sqr()?.broadcast_mul(&pair_mask)?)?.sum_all()?;
         let count = pair_mask.sum_all()?.to_scalar::<f32>()? as f64 * d as f64;
         Some((sum, count))
     } else {
         None
     };
-    if !rotation {
+    if terms.geo == 0.0 {
         return Ok(LossSums { squared, values, rotation: None, tokens, velocity });
     }
     // The rotation term needs the 6D values in physical units: undo each skeleton's
@@ -489,7 +587,7 @@ fn loss_sums(
     let std = Tensor::from_vec(std, (b, 1, j, 6), device)?;
     let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(3, 3, 6)?.broadcast_mul(&std)?.broadcast_add(&mean) };
     let geo = rotation_distance(&physical(&predicted)?, &physical(&clean.x)?)?;
-    let rotation = geo.unsqueeze(3)?.broadcast_mul(&mask)?.sum_all()?;
+    let rotation = weighed(geo.unsqueeze(3)?.broadcast_mul(&mask)?)?.sum_all()?;
     Ok(LossSums { squared, values, rotation: Some(rotation), tokens, velocity })
 }
 
@@ -505,12 +603,11 @@ pub fn train_step(
     rng: &mut SplitMix64,
     batch: usize,
     crop: usize,
-    lambda_geo: f64,
-    lambda_vel: f64,
+    terms: LossTerms,
     device: &Device,
 ) -> Result<StepStats, NnError> {
     let draw = draw_step(set, schedule, rng, batch, crop)?;
-    let (value, grads) = step_gradients(model, set, schedule, &draw, lambda_geo, lambda_vel, device)?;
+    let (value, grads) = step_gradients(model, set, schedule, &draw, terms, device)?;
     if !value.is_finite() {
         // No update from a NaN gradient: the caller stops with the model as it was.
         return Ok(StepStats { loss: value });
@@ -654,7 +751,7 @@ mod tests {
                 opt.load_state(&state, step).unwrap();
                 let _ = std::fs::remove_dir_all(&dir);
             }
-            losses.push(train_step(&model, &vars, &mut opt, set, &schedule, &mut rng, 2, 12, 1.0, 0.0, &dev).unwrap().loss);
+            losses.push(train_step(&model, &vars, &mut opt, set, &schedule, &mut rng, 2, 12, LossTerms::REFERENCE, &dev).unwrap().loss);
         }
         losses
     }
@@ -688,7 +785,21 @@ mod tests {
                 let losses: Vec<u64> = (0..2)
                     .map(|k| {
                         let mut rng = SplitMix64::new(40 + k);
-                        train_step(&model, &vars, &mut opt, &set, &schedule, &mut rng, 6, 12, 1.0, 0.5, &dev).unwrap().loss.to_bits()
+                        train_step(
+                            &model,
+                            &vars,
+                            &mut opt,
+                            &set,
+                            &schedule,
+                            &mut rng,
+                            6,
+                            12,
+                            LossTerms { geo: 1.0, vel: 0.5, weighting: Weighting::MinSnr(5.0) },
+                            &dev,
+                        )
+                        .unwrap()
+                        .loss
+                        .to_bits()
                     })
                     .collect();
                 (losses, parameters(&vars))
@@ -711,12 +822,13 @@ mod tests {
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
         let vars = named_vars(&varmap);
         let schedule = Schedule::cosine(100);
-        for (geo, vel) in [(1.0, 0.0), (1.0, 1.0), (0.0, 0.5)] {
-            let reference = training_loss(&model, &set, &schedule, &mut SplitMix64::new(9), 6, 12, geo, vel, &dev).unwrap();
+        for (geo, vel, weighting) in [(1.0, 0.0, Weighting::X0), (1.0, 1.0, Weighting::V), (0.0, 0.5, Weighting::MinSnr(5.0))] {
+            let terms = LossTerms { geo, vel, weighting };
+            let reference = training_loss(&model, &set, &schedule, &mut SplitMix64::new(9), 6, 12, terms, &dev).unwrap();
             let want = reference.backward().unwrap();
             let draw = draw_step(&set, &schedule, &mut SplitMix64::new(9), 6, 12).unwrap();
             assert!(draw.groups.len() > 1);
-            let (loss, parts) = step_gradients(&model, &set, &schedule, &draw, geo, vel, &dev).unwrap();
+            let (loss, parts) = step_gradients(&model, &set, &schedule, &draw, terms, &dev).unwrap();
             let expected = reference.to_scalar::<f32>().unwrap() as f64;
             assert!((loss - expected).abs() < 1e-5 * expected.abs(), "loss {loss} against {expected}");
             for (name, var) in &vars {
@@ -852,7 +964,17 @@ mod tests {
         let set = set();
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
-        let loss = training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, 1.0, 1.0, &dev).unwrap();
+        let loss = training_loss(
+            &model,
+            &set,
+            &Schedule::cosine(100),
+            &mut SplitMix64::new(9),
+            3,
+            12,
+            LossTerms { geo: 1.0, vel: 1.0, weighting: Weighting::X0 },
+            &dev,
+        )
+        .unwrap();
         let grads = loss.backward().unwrap();
         let vars = named_vars(&varmap);
         assert!(!vars.is_empty());
@@ -870,12 +992,68 @@ mod tests {
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
         let loss = |vel: f64| {
-            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, 1.0, vel, &dev).unwrap().to_scalar::<f32>().unwrap() as f64
+            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, LossTerms { geo: 1.0, vel, weighting: Weighting::X0 }, &dev)
+                .unwrap()
+                .to_scalar::<f32>()
+                .unwrap() as f64
         };
         let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
         // Same draws, so the term is linear in its weight; an untrained model's changes are off.
         assert!(one > off, "{one} vs {off}");
         assert!(((two - off) - 2.0 * (one - off)).abs() < 1e-4 * two.abs().max(1.0), "{off} {one} {two}");
+    }
+
+    #[test]
+    fn weightings_average_one_and_order_the_steps_as_their_formulas() {
+        let schedule = Schedule::cosine_shifted(100, 10.0);
+        for w in [Weighting::X0, Weighting::V, Weighting::MinSnr(5.0), Weighting::MinSnr(0.01)] {
+            let weights = w.weights(&schedule);
+            let mean = weights.iter().sum::<f64>() / weights.len() as f64;
+            assert!((mean - 1.0).abs() < 1e-12, "{w}: mean {mean}");
+            assert!(weights.iter().all(|x| x.is_finite() && *x >= 0.0), "{w}");
+        }
+        assert!(Weighting::X0.weights(&schedule).iter().all(|&x| x == 1.0));
+        // Noise grows with the step: v counts the clean end more, min-SNR the noisy end less.
+        let v = Weighting::V.weights(&schedule);
+        let m = Weighting::MinSnr(5.0).weights(&schedule);
+        assert!(v[0] > v[50] && v[50] >= v[99], "{} {} {}", v[0], v[50], v[99]);
+        assert!(m[0] > 100.0 * m[60], "{} {}", m[0], m[60]);
+        // A cap below every step's SNR weighs them all alike.
+        let schedule = Schedule::cosine(100);
+        let floor = schedule.alpha_bars.iter().map(|ab| ab / (1.0 - ab)).fold(f64::INFINITY, f64::min);
+        assert!(Weighting::MinSnr(floor / 2.0).weights(&schedule).iter().all(|&x| (x - 1.0).abs() < 1e-12));
+    }
+
+    #[test]
+    fn weightings_parse_and_print_back() {
+        for text in ["x0", "v", "min-snr:5", "min-snr:0.5"] {
+            let w: Weighting = text.parse().unwrap();
+            assert_eq!(w.to_string(), text);
+        }
+        assert_eq!("min-snr".parse::<Weighting>().unwrap(), Weighting::MinSnr(5.0));
+        for bad in ["", "eps", "min-snr:", "min-snr:-1", "min-snr:nan", "min-snr:inf", "min-snr:0"] {
+            assert!(bad.parse::<Weighting>().is_err(), "{bad:?} parsed");
+        }
+    }
+
+    #[test]
+    fn a_weighting_scales_each_crops_error_by_its_steps_weight() {
+        // One crop per draw: the weighted loss is the plain loss times that step's weight.
+        let dev = Device::Cpu;
+        let set = set();
+        let varmap = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
+        let schedule = Schedule::cosine_shifted(100, 10.0);
+        for seed in [3, 9, 21] {
+            let loss = |weighting| {
+                let terms = LossTerms { geo: 1.0, vel: 0.5, weighting };
+                training_loss(&model, &set, &schedule, &mut SplitMix64::new(seed), 1, 12, terms, &dev).unwrap().to_scalar::<f32>().unwrap() as f64
+            };
+            let step = draw_step(&set, &schedule, &mut SplitMix64::new(seed), 1, 12).unwrap().groups[0].steps[0] as usize;
+            let w = Weighting::MinSnr(5.0).weights(&schedule)[step];
+            let (plain, weighted) = (loss(Weighting::X0), loss(Weighting::MinSnr(5.0)));
+            assert!((weighted - w * plain).abs() <= 1e-5 * weighted.abs().max(1e-3), "step {step}: {weighted} vs {w} x {plain}");
+        }
     }
 
     #[test]

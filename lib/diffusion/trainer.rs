@@ -9,7 +9,7 @@
 use super::checkpoint::{self, CheckpointInfo, TrainedSkeleton};
 use super::data::TrainSet;
 use super::ema::Ema;
-use super::train::{named_vars, train_step, AdamW};
+use super::train::{named_vars, train_step, AdamW, LossTerms, Weighting};
 use super::Schedule;
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
 use crate::rng::SplitMix64;
@@ -237,6 +237,9 @@ pub struct AnyTopOptions {
     pub lambda_geo: f64,
     /// Weight of the velocity loss (frame-to-frame changes) next to the MSE.
     pub lambda_vel: f64,
+    /// How diffusion steps weigh in the loss: none = x0 for a new run (AnyTop's), the
+    /// checkpoint's for a resumed one or a fine-tune.
+    pub weighting: Option<Weighting>,
     pub augment: f64,
     pub augment_variants: usize,
     /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
@@ -382,6 +385,7 @@ impl AnyTopTrainer {
             augment_variants: 0,
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
+            weighting: base.map_or(Weighting::X0, |b| b.weighting),
             init: None,
             skeletons: Vec::new(),
         };
@@ -402,6 +406,9 @@ impl AnyTopTrainer {
         };
         if let Some(shift) = opts.noise_shift {
             info.noise_shift = shift;
+        }
+        if let Some(weighting) = opts.weighting {
+            info.weighting = weighting;
         }
         let schedule = info.schedule();
         info.augment = opts.augment;
@@ -472,8 +479,7 @@ impl Trainer for AnyTopTrainer {
             &mut rng,
             self.batch,
             self.crop,
-            self.lambda_geo,
-            self.lambda_vel,
+            LossTerms { geo: self.lambda_geo, vel: self.lambda_vel, weighting: self.info.weighting },
             &self.device,
         )?;
         if stats.loss.is_finite() {
