@@ -87,6 +87,8 @@ impl Profile {
 /// How far apart two skeletons are, in parts.
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
 pub struct Distance {
+    /// The sum of the parts; reported once, as `Score::score`.
+    #[serde(skip)]
     pub total: f64,
     pub graph: f64,
     pub proportions: f64,
@@ -148,7 +150,8 @@ pub fn distance(a: &Profile, b: &Profile) -> Distance {
 pub struct Score {
     /// The distance to the nearest training skeleton (`Distance::total`).
     pub score: f64,
-    /// Scores above this are out of range.
+    /// Scores above this are out of range (reports give it once, beside their skeletons).
+    #[serde(skip)]
     pub limit: f64,
     pub in_range: bool,
     /// The nearest training skeleton, and the parts of the distance to it.

@@ -50,6 +50,10 @@ fn a_star_is_warned_about_and_a_trained_skeleton_is_not() {
     assert_eq!((a["in_range"].as_bool(), b["in_range"].as_bool(), b["score"].as_f64()), (Some(false), Some(true), Some(0.0)));
     assert!(a["score"].as_f64().unwrap() > 2.0 * limit, "{a}");
     assert_eq!(b["nearest"].as_str(), Some("quadruped_v0"));
+    // Each number once: the limit beside the skeletons, the total as the score.
+    assert!(a.get("limit").is_none() && a["parts"].get("total").is_none(), "{a}");
+    let parts: f64 = ["graph", "proportions", "names"].iter().map(|k| a["parts"][k].as_f64().unwrap()).sum();
+    assert!((parts - a["score"].as_f64().unwrap()).abs() < 1e-9, "{a}");
     // The latent model has its own training skeletons.
     let latent = ood_json(&["--latent", s(&star), s(&quad)]);
     assert_eq!((latent["skeletons"][0]["ood"]["in_range"].as_bool(), latent["skeletons"][1]["ood"]["in_range"].as_bool()), (Some(false), Some(true)));
