@@ -237,7 +237,7 @@ pub struct AnyTopOptions {
     pub lambda_geo: f64,
     /// Weight of the velocity loss (frame-to-frame changes) next to the MSE.
     pub lambda_vel: f64,
-    /// How diffusion steps weigh in the loss: none = x0 for a new run (AnyTop's), the
+    /// How diffusion steps weigh in the loss: none = `DEFAULT_WEIGHTING` for a new run, the
     /// checkpoint's for a resumed one or a fine-tune.
     pub weighting: Option<Weighting>,
     pub augment: f64,
@@ -256,6 +256,13 @@ pub struct AnyTopOptions {
 /// 0.21-0.24 of the clips' with AnyTop's schedule (1), 0.38-0.61 at 10 with crop-relative
 /// positions. 20 and 40 were not better on a 1-skeleton proxy.
 pub const DEFAULT_NOISE_SHIFT: f64 = 10.0;
+
+/// The loss weighting of a new run. Measured on the 3-skeleton proxy (quadruped, biped, spider
+/// of the zoo, tiny preset, 4,000 steps, two training seeds; models/zoo-small/MODEL_CARD.md):
+/// `v` gave samples 0.47-0.74 of the clips' motion energy against 0.34-0.61 with `x0` (higher
+/// on all six pairs, poses as near the clips', jerk still inside the clips' range);
+/// `min-snr` starved the noisy steps and gave jitter (jerk 4-6x the clips').
+pub const DEFAULT_WEIGHTING: Weighting = Weighting::V;
 
 /// Where a denoiser run starts.
 pub enum AnyTopStart {
@@ -341,6 +348,11 @@ impl AnyTopResume {
         i.batch != opts.batch || i.crop != opts.crop || i.seed != opts.seed || i.augment != opts.augment || i.augment_variants != opts.augment_variants
     }
 
+    /// The loss weighting the checkpoint was trained with, when `opts` asks for another.
+    pub fn weighting_changes(&self, opts: &AnyTopOptions) -> Option<(Weighting, Weighting)> {
+        opts.weighting.filter(|&w| w != self.loaded.info.weighting).map(|w| (self.loaded.info.weighting, w))
+    }
+
     /// The noise shift the checkpoint was trained with, when `opts` asks for another.
     pub fn shift_changes(&self, opts: &AnyTopOptions) -> Option<(f64, f64)> {
         opts.noise_shift.filter(|&s| s != self.loaded.info.noise_shift).map(|s| (self.loaded.info.noise_shift, s))
@@ -385,7 +397,7 @@ impl AnyTopTrainer {
             augment_variants: 0,
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
-            weighting: base.map_or(Weighting::X0, |b| b.weighting),
+            weighting: base.map_or(DEFAULT_WEIGHTING, |b| b.weighting),
             init: None,
             skeletons: Vec::new(),
         };

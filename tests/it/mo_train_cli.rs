@@ -194,6 +194,40 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     assert!(!other.join("checkpoint.json").exists());
 }
 
+/// A new run records its loss weighting (v by default), a resumed run keeps it unless it is
+/// given again (then it says so), and the weighting changes what is learnt.
+#[test]
+fn the_loss_weighting_is_recorded_and_kept_on_resume() {
+    let dir = tempdir("train-weighting");
+    let data = data(&dir);
+    let out = dir.join("model");
+    ok(&run("mo-train", &train_args(&data, &out, "2"), None), "default");
+    assert_eq!(info(&out)["weighting"].as_str(), Some("v"));
+    let x0 = dir.join("x0");
+    let mut args = train_args(&data, &x0, "2");
+    args.extend(["--loss-weighting", "x0"]);
+    ok(&run("mo-train", &args, None), "x0");
+    // x0, the reference's, is what a checkpoint without the field means.
+    assert!(info(&x0).get("weighting").is_none(), "{}", info(&x0));
+    let read = |d: &std::path::Path| std::fs::read(d.join("model.safetensors")).unwrap();
+    assert_ne!(read(&out), read(&x0), "the weighting made no difference");
+    let mut args = train_args(&data, &out, "3");
+    args.push("--resume");
+    ok(&run("mo-train", &args, None), "resume");
+    assert_eq!(info(&out)["weighting"].as_str(), Some("v"));
+    let mut args = train_args(&data, &out, "4");
+    args.extend(["--resume", "--loss-weighting", "min-snr:2"]);
+    let changed = run("mo-train", &args, None);
+    ok(&changed, "resume with another weighting");
+    assert!(String::from_utf8_lossy(&changed.stderr).contains("--loss-weighting v"), "no note about the change");
+    assert_eq!(info(&out)["weighting"]["min-snr"].as_f64(), Some(2.0));
+    let other = dir.join("other");
+    let mut args = train_args(&data, &other, "1");
+    args.extend(["--loss-weighting", "eps"]);
+    common::check_failure("mo-train", "weighting eps", &run("mo-train", &args, None), "--loss-weighting");
+    assert!(!other.join("checkpoint.json").exists());
+}
+
 /// `--init DIR` starts a new run from that model's weights, size and noise schedule, with the
 /// fine-tune defaults (--lr 3e-4, --augment 0) and a note of where it started; `--init
 /// builtin` does the same from the model inside the binaries; `--minutes` ends a run on time
