@@ -6,7 +6,7 @@
 A glTF/GLB file is given as FILE.glb=REFERENCE.bvh: it is imported with Blender's glTF add-on
 (`import_scene.gltf`, Debian needs `python3-numpy` for it) and its bone heads are compared with
 the FK of the BVH it was made from (or one the tools wrote back from it), at several frames.
-The scene's frame rate is set to the reference's, so key k lands on a whole frame.
+The scene's frame rate is set to the reference's and key k is looked at at its own time.
 
 Prints one JSON line `BLENDERCHECK [...]`: per file the bones Blender made, the joints and
 frames of the file, the imported action's frame range, and the largest distance between
@@ -40,6 +40,19 @@ if "bool" not in np.__dict__:
     np.bool = bool
 
 
+def head_error(arm, names, positions):
+    """The largest distance between a bone's head and the joint of its name, at this frame."""
+    worst = 0.0
+    for i, name in enumerate(names):
+        bone = arm.pose.bones.get(name)
+        if bone is None:
+            continue
+        h = arm.matrix_world @ bone.head
+        # Both importers turn the file's Y-up into Blender's Z-up: (x, y, z) -> (x, -z, y).
+        worst = max(worst, float(np.linalg.norm(np.array([h.x, h.z, -h.y]) - positions[i])))
+    return worst
+
+
 def check(path):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.import_anim.bvh(filepath=path, axis_forward="-Z", axis_up="Y", rotate_mode="NATIVE")
@@ -51,13 +64,7 @@ def check(path):
     worst = 0.0
     for k in sorted({0, frames // 2, frames - 1}):
         bpy.context.scene.frame_set(start + k)
-        for i, name in enumerate(names):
-            bone = arm.pose.bones.get(name)
-            if bone is None:
-                continue
-            h = arm.matrix_world @ bone.head
-            # The importer turns the file's Y-up into Blender's Z-up: (x, y, z) -> (x, -z, y).
-            worst = max(worst, float(np.linalg.norm(np.array([h.x, h.z, -h.y]) - positions[k, i])))
+        worst = max(worst, head_error(arm, names, positions[k]))
     height = float(np.ptp(positions[0, :, 1])) or 1.0
     return {"file": path, "bones": len(arm.data.bones), "joints": len(names), "frames": frames,
             "action_frames": list(arm.animation_data.action.frame_range),
@@ -69,10 +76,10 @@ def check_gltf(path, reference):
     names, positions, frame_time = bvhfk.fk(reference)
     positions = np.asarray(positions)
     frames = positions.shape[0]
-    # Blender keys a glTF time t at frame t * fps / fps_base: make that the key's index exactly.
+    # Blender keys a glTF time t at frame t * fps (the scene's whole fps, fps_base ignored):
+    # look at key k there, with a subframe when the frame time is not 1/fps exactly.
     fps = max(1, round(1.0 / frame_time))
     bpy.context.scene.render.fps = fps
-    bpy.context.scene.render.fps_base = fps * frame_time
     bpy.ops.import_scene.gltf(filepath=path)
     arm = [o for o in bpy.context.scene.objects if o.type == "ARMATURE"][0]
     action = arm.animation_data.action if arm.animation_data else None
@@ -81,14 +88,9 @@ def check_gltf(path, reference):
     for k in sorted({0, 1, frames // 3, frames // 2, frames - 1}):
         if k >= frames:
             continue
-        bpy.context.scene.frame_set(start + k)
-        for i, name in enumerate(names):
-            bone = arm.pose.bones.get(name)
-            if bone is None:
-                continue
-            h = arm.matrix_world @ bone.head
-            # The glTF importer turns Y-up into Blender's Z-up, as the BVH importer does.
-            worst = max(worst, float(np.linalg.norm(np.array([h.x, h.z, -h.y]) - positions[k, i])))
+        at = start + float(np.float32(k * frame_time)) * fps
+        bpy.context.scene.frame_set(int(at), subframe=at - int(at))
+        worst = max(worst, head_error(arm, names, positions[k]))
     height = float(np.ptp(positions[0, :, 1])) or 1.0
     joints_found = sum(1 for n in names if arm.pose.bones.get(n) is not None)
     return {"file": path, "reference": reference, "bones": len(arm.data.bones), "joints": len(names),

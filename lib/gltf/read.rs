@@ -167,7 +167,21 @@ impl Reader<'_> {
                 translations.push(p);
             }
         }
-        let motion = Motion { frames: times.len(), joints: nj, frame_time, rotations, translations };
+        // Exporters (Blender) key every bone's translation, at its rest value up to float
+        // noise: such a joint does not translate, and keeps the 3 rotation channels in BVH.
+        let frames = times.len();
+        let bone = joints.iter().map(|j| j.offset.length()).sum::<f64>() / nj as f64;
+        let mut moves = vec![false; nj];
+        for (j, joint) in joints.iter().enumerate().skip(1) {
+            let tol = 1e-6 * joint.offset.length().max(bone);
+            moves[j] = (0..frames).any(|f| translations[f * nj + j].distance(joint.offset) > tol);
+            if !moves[j] {
+                for f in 0..frames {
+                    translations[f * nj + j] = joint.offset;
+                }
+            }
+        }
+        let motion = Motion { frames, joints: nj, frame_time, rotations, translations };
         if let Some((f, j)) = motion.first_non_finite() {
             return Err(self.data(format!("frame {f}, joint '{}': the animation gives a non-finite pose", joints[j].name)));
         }
@@ -175,8 +189,7 @@ impl Reader<'_> {
         // Channels, for writing BVH: the root and any joint whose translation moves off its
         // offset carry positions (a BVH position channel replaces the OFFSET).
         for (j, joint) in joints.iter_mut().enumerate() {
-            let moves = j == 0 || (0..motion.frames).any(|f| motion.translations[f * nj + j] != joint.offset);
-            if moves {
+            if j == 0 || moves[j] {
                 joint.channels.extend([Channel::Xposition, Channel::Yposition, Channel::Zposition]);
             }
             joint.channels.extend([Channel::Zrotation, Channel::Xrotation, Channel::Yrotation]);

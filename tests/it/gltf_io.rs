@@ -171,3 +171,31 @@ fn malformed_gltf_is_one_line_exit_2() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A GLB written by Blender 3.4's own exporter (tools/blender_export_gltf.py on the first 12
+/// frames of the bundled quadruped): rest rotations on every bone, translation and scale keys
+/// on every bone, f32 noise. Its joints must land where the BVH's do.
+#[test]
+fn reads_a_blender_export() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let bytes = std::fs::read(root.join("tests/fixtures/quadruped_blender34.glb")).unwrap();
+    let parsed = parse_motion(&bytes, "blender.glb", Path::new("blender.glb")).unwrap();
+    let skeleton = Skeleton::from_bvh(&parsed);
+    let motion = Motion::from_bvh(&parsed, &skeleton);
+    let (s0, m0) = common::load(&root.join("examples/data/quadruped.bvh"));
+    let m0 = m0.first_frames(12);
+    assert_eq!(motion.frames, 12);
+    assert!((skeleton.frame_time - s0.frame_time).abs() < 1e-6);
+    assert!(skeleton.joints.iter().all(|j| j.channels.len() == if j.parent.is_none() { 6 } else { 3 }), "rest-valued translation keys are not motion");
+    let (p, p0) = (motion.forward_kinematics(&skeleton), m0.forward_kinematics(&s0));
+    let mut worst: f64 = 0.0;
+    for (j, joint) in skeleton.joints.iter().enumerate() {
+        let k = s0.joints.iter().position(|x| x.name == joint.name).unwrap_or_else(|| panic!("joint {}", joint.name));
+        for f in 0..12 {
+            worst = worst.max(p.position(f, j).distance(p0.position(f, k)));
+        }
+    }
+    assert_eq!(skeleton.joints.len(), s0.joints.len());
+    let err = worst / s0.rest_height();
+    assert!(err < 1e-5, "{err}");
+}
