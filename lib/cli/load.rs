@@ -37,7 +37,8 @@ pub fn is_gltf(path: &Path, bytes: &[u8]) -> bool {
     struct Probe {
         asset: Option<serde::de::IgnoredAny>,
     }
-    gltf::looks_like_gltf(path, bytes) || (bytes.trim_ascii_start().starts_with(b"{") && serde_json::from_slice::<Probe>(bytes).is_ok_and(|p| p.asset.is_some()))
+    gltf::looks_like_gltf(path, bytes)
+        || (bytes.trim_ascii_start().starts_with(b"{") && serde_json::from_slice::<Probe>(bytes).is_ok_and(|p| p.asset.is_some()))
 }
 
 /// The skeleton and motion of a glTF file (`--animation`, `--fps` as given for this run).

@@ -24,12 +24,12 @@ use crate::cli::load::{is_dash, read_skeleton, split_samples, Decoder, SkeletonA
 pub use crate::cli::load::{load_skeleton, DecodeFrom, MotionFormat};
 use crate::cli::CommonOpts;
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
+use crate::io;
 use crate::io::npy;
 use crate::motion::Motion;
 use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource};
 use crate::repr::{m2m, Features};
 use crate::skeleton::{lookup, topology, Skeleton};
-use crate::io;
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};

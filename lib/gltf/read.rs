@@ -140,7 +140,9 @@ impl Reader<'_> {
             }
             let end_sites = node
                 .children()
-                .filter(|c| !joint_of_node.contains_key(&c.index()) && c.children().next().is_none() && c.mesh().is_none() && c.skin().is_none() && c.camera().is_none())
+                .filter(|c| {
+                    !joint_of_node.contains_key(&c.index()) && c.children().next().is_none() && c.mesh().is_none() && c.skin().is_none() && c.camera().is_none()
+                })
                 .map(|c| DVec3::from_array(c.transform().decomposed().0.map(f64::from)) * scale)
                 .filter(|e| e.is_finite())
                 .collect();
@@ -333,7 +335,8 @@ impl Reader<'_> {
             let input = sampler.input();
             let output = sampler.output();
             self.check_accessor(&input, &[DataType::F32], Dimensions::Scalar, &what(name))?;
-            let types: &[DataType] = if property == Property::Rotation { &[DataType::F32, DataType::I8, DataType::U8, DataType::I16, DataType::U16] } else { &[DataType::F32] };
+            let types: &[DataType] =
+                if property == Property::Rotation { &[DataType::F32, DataType::I8, DataType::U8, DataType::I16, DataType::U16] } else { &[DataType::F32] };
             self.check_accessor(&output, types, dims, &what(name))?;
             let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
             if output.count() != input.count() * per_key {
@@ -409,7 +412,12 @@ impl Reader<'_> {
             return Err(self.data(format!("{what}: sparse or buffer-less accessors are not supported")));
         }
         if !types.contains(&accessor.data_type()) || accessor.dimensions() != dims {
-            return Err(self.data(format!("{what}: accessor {} is {:?} {:?}, expected {dims:?} of {types:?}", accessor.index(), accessor.dimensions(), accessor.data_type())));
+            return Err(self.data(format!(
+                "{what}: accessor {} is {:?} {:?}, expected {dims:?} of {types:?}",
+                accessor.index(),
+                accessor.dimensions(),
+                accessor.data_type()
+            )));
         }
         let element = accessor.size();
         if let Some(view) = accessor.view() {
@@ -448,7 +456,8 @@ impl Reader<'_> {
                 }
             }
         };
-        let frames = ((last - first) / step + 1e-6).floor() + 1.0;
+        // Key times are float32: a last key a hair before a whole step still counts as that step.
+        let frames = ((last - first) / step + 1e-4).floor() + 1.0;
         if !(frames <= options.max_frames as f64) {
             return Err(self.data(format!(
                 "the animation lasts {:.3} s: {frames:.0} frames at {:.3} fps, more than the {} a motion may have",

@@ -60,10 +60,7 @@ impl Track {
                 let (w2, w3) = (w * w, w * w * w);
                 let out_a = self.values[3 * a + 2];
                 let in_b = self.values[3 * b];
-                self.key(a) * (2.0 * w3 - 3.0 * w2 + 1.0)
-                    + out_a * (dt * (w3 - 2.0 * w2 + w))
-                    + self.key(b) * (-2.0 * w3 + 3.0 * w2)
-                    + in_b * (dt * (w3 - w2))
+                self.key(a) * (2.0 * w3 - 3.0 * w2 + 1.0) + out_a * (dt * (w3 - 2.0 * w2 + w)) + self.key(b) * (-2.0 * w3 + 3.0 * w2) + in_b * (dt * (w3 - w2))
             }
             _ => self.key(a).lerp(self.key(b), w),
         }

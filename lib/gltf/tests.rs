@@ -110,3 +110,40 @@ fn armature_transforms_above_the_root_are_baked_in() {
     assert!(p.position(0, 0).distance(glam::DVec3::new(1.0, 3.0, 3.0)) < 1e-6, "{:?}", p.position(0, 0));
     assert!(p.position(0, 1).distance(glam::DVec3::new(1.0, 3.0, 2.0)) < 1e-6, "{:?}", p.position(0, 1));
 }
+
+#[test]
+fn step_rotations_and_cubic_joint_translations_from_a_data_uri() {
+    use base64::Engine as _;
+    // Root: STEP rotation keys at 0, 0.5, 1 s (identity, 90 degrees about z, identity).
+    // Tip: CUBICSPLINE translation keys at 0 and 1 s from x = 1 to x = 3, zero tangents.
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let mut floats: Vec<f32> = vec![0.0, 0.5, 1.0];
+    floats.extend([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, s, s, 0.0, 0.0, 0.0, 1.0]);
+    floats.extend([0.0, 1.0]);
+    floats.extend([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    let uri = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},
+        "buffers":[{{"byteLength":{len},"uri":"data:application/octet-stream;base64,{uri}"}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":12}},{{"buffer":0,"byteOffset":12,"byteLength":48}},
+                       {{"buffer":0,"byteOffset":60,"byteLength":8}},{{"buffer":0,"byteOffset":68,"byteLength":72}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"SCALAR","min":[0],"max":[1]}},
+                     {{"bufferView":1,"componentType":5126,"count":3,"type":"VEC4"}},
+                     {{"bufferView":2,"componentType":5126,"count":2,"type":"SCALAR","min":[0],"max":[1]}},
+                     {{"bufferView":3,"componentType":5126,"count":6,"type":"VEC3"}}],
+        "nodes":[{{"name":"root","translation":[0,1,0],"children":[1]}},{{"name":"tip","translation":[1,0,0]}}],
+        "skins":[{{"joints":[0,1]}}],
+        "animations":[{{"name":"a","samplers":[{{"input":0,"output":1,"interpolation":"STEP"}},{{"input":2,"output":3,"interpolation":"CUBICSPLINE"}}],
+                        "channels":[{{"sampler":0,"target":{{"node":0,"path":"rotation"}}}},{{"sampler":1,"target":{{"node":1,"path":"translation"}}}}]}}]}}"#,
+        len = bytes.len()
+    );
+    let (skeleton, motion) = read(json.as_bytes(), "t.gltf", None, &ReadOptions::default()).unwrap();
+    assert_eq!((motion.frames, skeleton.frame_time), (3, 0.5));
+    assert_eq!(skeleton.joints[1].channels.len(), 6, "a translating joint carries position channels");
+    let p = motion.forward_kinematics(&skeleton);
+    let close = |a: glam::DVec3, b: [f64; 3]| a.distance(glam::DVec3::from_array(b)) < 1e-6;
+    assert!(close(p.position(0, 1), [1.0, 1.0, 0.0]), "{:?}", p.position(0, 1));
+    assert!(close(p.position(1, 1), [0.0, 3.0, 0.0]), "{:?}", p.position(1, 1));
+    assert!(close(p.position(2, 1), [3.0, 1.0, 0.0]), "{:?}", p.position(2, 1));
+}

@@ -219,14 +219,10 @@ impl Builder {
 
         let material = Index::new(self.root.materials.len() as u32);
         self.root.materials.push(json::Material { name: Some("bone".to_string()), double_sided: true, ..Default::default() });
-        let attributes = [
-            (json::mesh::Semantic::Positions, positions),
-            (json::mesh::Semantic::Joints(0), joints),
-            (json::mesh::Semantic::Weights(0), weights),
-        ]
-        .into_iter()
-        .map(|(s, a)| (Valid(s), a))
-        .collect();
+        let attributes = [(json::mesh::Semantic::Positions, positions), (json::mesh::Semantic::Joints(0), joints), (json::mesh::Semantic::Weights(0), weights)]
+            .into_iter()
+            .map(|(s, a)| (Valid(s), a))
+            .collect();
         let mesh = Index::new(self.root.meshes.len() as u32);
         self.root.meshes.push(json::Mesh {
             extensions: None,
