@@ -169,13 +169,14 @@ impl Reader<'_> {
                 translations.push(p);
             }
         }
-        // Exporters (Blender) key every bone's translation, at its rest value up to float
-        // noise: such a joint does not translate, and keeps the 3 rotation channels in BVH.
+        // Exporters (Blender) key every bone's translation, at its rest value up to float32
+        // noise (measured up to 2e-6 of the bone in Blender 3.4's): such a joint does not
+        // translate, and keeps the 3 rotation channels in BVH.
         let frames = times.len();
         let bone = joints.iter().map(|j| j.offset.length()).sum::<f64>() / nj as f64;
         let mut moves = vec![false; nj];
         for (j, joint) in joints.iter().enumerate().skip(1) {
-            let tol = 1e-6 * joint.offset.length().max(bone);
+            let tol = 5e-6 * joint.offset.length().max(bone);
             moves[j] = (0..frames).any(|f| translations[f * nj + j].distance(joint.offset) > tol);
             if !moves[j] {
                 for f in 0..frames {
@@ -467,7 +468,7 @@ impl Reader<'_> {
             )));
         }
         let times = if from_keys { keys } else { (0..frames as usize).map(|i| first + i as f64 * step).collect() };
-        let frame_time = if options.fps.is_some() { step } else { shortest_decimal(step) };
+        let frame_time = if options.fps.is_some() { step } else { frame_time_of_keys(step) };
         Ok((times, frame_time))
     }
 }
@@ -502,9 +503,14 @@ fn joint_name(name: Option<&str>, k: usize) -> String {
     }
 }
 
-/// A frame time read back from f32 key times: the shortest decimal within f32 precision of it,
-/// so a BVH's `Frame Time: 0.0333333` comes back as written rather than as 0.03333333134651184.
-fn shortest_decimal(step: f64) -> f64 {
+/// A frame time read back from f32 key times: 1/N seconds when it is that within f32 precision
+/// (1/30 comes back as 1/30), else the shortest decimal within it, so a BVH's `Frame Time:
+/// 0.0333333` comes back as written rather than as 0.03333333134651184.
+fn frame_time_of_keys(step: f64) -> f64 {
+    let per_second = (1.0 / step).round();
+    if per_second >= 1.0 && (1.0 / per_second - step).abs() <= 1.5e-7 * step {
+        return 1.0 / per_second;
+    }
     for digits in 1..=17 {
         let scale = 10f64.powi(digits);
         let rounded = (step * scale).round() / scale;
