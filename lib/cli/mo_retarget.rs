@@ -26,7 +26,7 @@ EXAMPLES:
     mo-retarget examples/data/biped.bvh examples/data/biped.bvh --bind auto --seconds 2 -o b.bvh
     cat examples/data/spider.bvh | mo-retarget - examples/data/crab.bvh --bind auto --format npy
     mo-retarget --method latent examples/data/biped.bvh --to examples/data/quadruped.bvh -o q.bvh
-    mo-retarget examples/data/quadruped.bvh examples/data/dragon.bvh --bind auto --frames 30 -o dragon.glb";
+    mo-retarget examples/data/quadruped.bvh examples/data/dragon.bvh --bind auto -o dragon.glb";
 
 /// Transfer a motion to a different skeleton from a few example clips of it (Motion2Motion).
 ///
