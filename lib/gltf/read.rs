@@ -337,10 +337,10 @@ impl Reader<'_> {
             };
             let input = sampler.input();
             let output = sampler.output();
-            self.check_accessor(&input, &[DataType::F32], Dimensions::Scalar, &what(name))?;
+            self.check_accessor(&input, &[DataType::F32], Dimensions::Scalar, &what(name), buffers)?;
             let types: &[DataType] =
                 if property == Property::Rotation { &[DataType::F32, DataType::I8, DataType::U8, DataType::I16, DataType::U16] } else { &[DataType::F32] };
-            self.check_accessor(&output, types, dims, &what(name))?;
+            self.check_accessor(&output, types, dims, &what(name), buffers)?;
             let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
             if output.count() != input.count() * per_key {
                 return Err(self.data(format!("{}: {} keys but {} values", what(name), input.count(), output.count())));
@@ -424,7 +424,7 @@ impl Reader<'_> {
     }
 
     /// What the crate's reader assumes of an accessor and does not check itself.
-    fn check_accessor(&self, accessor: &Accessor, types: &[DataType], dims: Dimensions, what: &str) -> Result<(), GltfError> {
+    fn check_accessor(&self, accessor: &Accessor, types: &[DataType], dims: Dimensions, what: &str, buffers: &[Cow<[u8]>]) -> Result<(), GltfError> {
         if accessor.count() == 0 {
             return Err(self.data(format!("{what}: no keys")));
         }
@@ -439,10 +439,18 @@ impl Reader<'_> {
                 accessor.data_type()
             )));
         }
+        // The crate computes offset + stride * (count - 1) unchecked (and debug-asserts the
+        // stride): keep every term far from overflow and the stride at least an element.
         let element = accessor.size();
         if let Some(view) = accessor.view() {
-            if view.stride().is_some_and(|s| s < element) {
+            let stride = view.stride().unwrap_or(element);
+            if stride < element {
                 return Err(self.data(format!("{what}: accessor {} has a stride smaller than its elements", accessor.index())));
+            }
+            let data = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
+            let view_fits = view.offset().checked_add(view.length()).is_some_and(|end| end <= data);
+            if !view_fits || accessor.count() > view.length() || accessor.offset() > view.length() {
+                return Err(self.data(format!("{what}: accessor {} reaches past its buffer", accessor.index())));
             }
         }
         Ok(())
