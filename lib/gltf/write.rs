@@ -140,7 +140,7 @@ impl Builder {
         bounds: Option<(Vec<f32>, Vec<f32>)>,
         target: Option<json::buffer::Target>,
     ) -> Index<json::Accessor> {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let view = Index::new(self.root.buffer_views.len() as u32);
