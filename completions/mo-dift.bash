@@ -23,7 +23,7 @@ _mo__dift() {
 
     case "${cmd}" in
         mo__dift)
-            opts="-o -q -v -h -V --joints --frames --align --as-binding --bind-rate --t --layer --draws --model --skeleton --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --joints --frames --align --as-binding --bind-rate --t --layer --draws --model --skeleton --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -70,6 +70,14 @@ _mo__dift() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -9,6 +9,8 @@ complete -c mo-dift -l skeleton -d 'Skeleton (document or BVH) that NPY inputs a
 complete -c mo-dift -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-dift -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-dift -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-dift -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-dift -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-dift -l joints -d 'Joint correspondence between REF and TGT (JSON)'
 complete -c mo-dift -l frames -d 'Frame correspondence between REF and TGT (JSON)'
 complete -c mo-dift -l as-binding -d 'With --joints: write a sparse binding REF -> TGT for mo-retarget --bind'

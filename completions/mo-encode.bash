@@ -23,7 +23,7 @@ _mo__encode() {
 
     case "${cmd}" in
         mo__encode)
-            opts="-o -q -v -h -V --repr --decode --skeleton --rest-pose --face-joints --body-axis --feet --require-contacts --normalise --stats --emit-skeleton --placement --from --normalised --latent --decode-latent --model --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --repr --decode --skeleton --rest-pose --face-joints --body-axis --feet --require-contacts --normalise --stats --emit-skeleton --placement --from --normalised --latent --decode-latent --model --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -86,6 +86,14 @@ _mo__encode() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

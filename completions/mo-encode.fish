@@ -14,6 +14,8 @@ complete -c mo-encode -l model -d 'The latent model: a directory from \'mo-train
 complete -c mo-encode -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-encode -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-encode -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-encode -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-encode -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-encode -l decode -d 'Decode an NPY of features back to BVH on --skeleton'
 complete -c mo-encode -l require-contacts -d 'anytop: fail when the skeleton has no foot joints, instead of writing all-zero contact features with a warning (for training data of walkers, where a missed foot is a bug)'
 complete -c mo-encode -l normalise -d 'anytop: write normalised features, (x - mean) / (std + 1e-6)'

@@ -65,7 +65,7 @@ _mo__metrics() {
 
     case "${cmd}" in
         mo__metrics)
-            opts="-o -q -v -h -V --format --skeleton --from --output --seed --quiet --verbose --threads --help --version ood generation transfer reconstruction aggregate physics help"
+            opts="-o -q -v -h -V --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help --version ood generation transfer reconstruction aggregate physics help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -99,6 +99,14 @@ _mo__metrics() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 *)
                     COMPREPLY=()
                     ;;
@@ -107,7 +115,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__aggregate)
-            opts="-o -q -v -h --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            opts="-o -q -v -h --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -141,6 +149,14 @@ _mo__metrics() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 *)
                     COMPREPLY=()
                     ;;
@@ -149,7 +165,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__generation)
-            opts="-o -q -v -h --gt --gen --window --threshold --min-segment --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            opts="-o -q -v -h --gt --gen --window --threshold --min-segment --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -200,6 +216,14 @@ _mo__metrics() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
@@ -323,7 +347,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__ood)
-            opts="-o -q -v -h --model --latent --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            opts="-o -q -v -h --model --latent --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -361,6 +385,14 @@ _mo__metrics() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 *)
                     COMPREPLY=()
                     ;;
@@ -369,7 +401,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__physics)
-            opts="-o -q -v -h --ground --contact-height --contact-speed --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            opts="-o -q -v -h --ground --contact-height --contact-speed --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -415,6 +447,14 @@ _mo__metrics() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 *)
                     COMPREPLY=()
                     ;;
@@ -423,7 +463,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__reconstruction)
-            opts="-o -q -v -h --reference --result --height --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            opts="-o -q -v -h --reference --result --height --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -469,6 +509,14 @@ _mo__metrics() {
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
                 *)
                     COMPREPLY=()
                     ;;
@@ -477,7 +525,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__transfer)
-            opts="-o -q -v -h --source --result --binding --examples --seconds --fid-window --format --skeleton --from --output --seed --quiet --verbose --threads --help"
+            opts="-o -q -v -h --source --result --binding --examples --seconds --fid-window --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -532,6 +580,14 @@ _mo__metrics() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

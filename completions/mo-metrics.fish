@@ -1,6 +1,6 @@
 # Print an optspec for argparse to handle cmd's options that are independent of any subcommand.
 function __fish_mo_metrics_global_optspecs
-    string join \n format= skeleton= from= o/output= seed= q/quiet v/verbose threads= h/help V/version
+    string join \n format= skeleton= from= o/output= seed= q/quiet v/verbose threads= animation= fps= h/help V/version
 end
 
 function __fish_mo_metrics_needs_command
@@ -32,6 +32,8 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_needs_command" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -52,6 +54,8 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l latent -d 'Score against a latent model (SATA: mo-encode --latent, mo-retarget --method latent)'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s v -l verbose -d 'Print more about what is happening on stderr'
@@ -69,6 +73,8 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand generation" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -86,6 +92,8 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand transfer" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -100,6 +108,8 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand reconstruction" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -111,6 +121,8 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand aggregate" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -125,6 +137,8 @@ positions\t'The features\' joint positions, by inverse kinematics: for generated
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand physics" -s h -l help -d 'Print help (see more with \'--help\')'

@@ -23,7 +23,7 @@ _mo__render() {
 
     case "${cmd}" in
         mo__render)
-            opts="-o -q -v -h -V --sheet --gif --html --format --skeleton --from --view --frames --every --columns --rows --size --fixed-camera --joint-labels --frame-labels --overlay --speed --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --sheet --gif --html --format --skeleton --from --view --frames --every --columns --rows --size --fixed-camera --joint-labels --frame-labels --overlay --speed --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -102,6 +102,14 @@ _mo__render() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

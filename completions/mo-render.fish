@@ -19,6 +19,8 @@ complete -c mo-render -l speed -d 'HTML: initial playback speed' -r
 complete -c mo-render -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-render -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-render -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-render -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-render -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-render -l fixed-camera -d 'One camera for the whole clip (shows travel) instead of following the body'
 complete -c mo-render -l overlay -d 'HTML: draw all motions in one scene instead of side by side'
 complete -c mo-render -s q -l quiet -d 'Print nothing on stderr but errors'

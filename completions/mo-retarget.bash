@@ -23,7 +23,7 @@ _mo__retarget() {
 
     case "${cmd}" in
         mo__retarget)
-            opts="-n -o -q -v -h -V --bind --method --to --model --bind-rate --emit-binding --samples --frames --seconds --key-frames --format --patch --alpha --steps --pyramid --repr --bound-rotation --root-motion --copy-bound --report --output --seed --quiet --verbose --threads --help --version"
+            opts="-n -o -q -v -h -V --bind --method --to --model --bind-rate --emit-binding --samples --frames --seconds --key-frames --format --patch --alpha --steps --pyramid --repr --bound-rotation --root-motion --copy-bound --report --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -70,7 +70,7 @@ _mo__retarget() {
                     return 0
                     ;;
                 --format)
-                    COMPREPLY=($(compgen -W "bvh npy" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "bvh glb gltf npy" -- "${cur}"))
                     return 0
                     ;;
                 --patch)
@@ -114,6 +114,14 @@ _mo__retarget() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

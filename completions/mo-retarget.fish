@@ -8,8 +8,10 @@ complete -c mo-retarget -s n -l samples -d 'Number of diverse samples' -r
 complete -c mo-retarget -l frames -d 'Output length in frames [default: the source\'s, after resampling]' -r
 complete -c mo-retarget -l seconds -d 'Output length in seconds' -r
 complete -c mo-retarget -l key-frames -d 'Key-frame mode: the source counts only at these frames (comma-separated, source frames)' -r
-complete -c mo-retarget -l format -d 'Output format' -r -f -a "bvh\t''
-npy\t''"
+complete -c mo-retarget -l format -d 'Output format on stdout: BVH, glTF (glb: binary, gltf: JSON) or Motion2Motion features (npy). An -o file named .glb or .gltf is written as glTF' -r -f -a "bvh\t''
+glb\t'Binary glTF (skin, animation, a stick mesh)'
+gltf\t'glTF JSON, data inlined'
+npy\t'Motion2Motion features'"
 complete -c mo-retarget -l patch -d 'Patch length in frames (paper: 11)' -r
 complete -c mo-retarget -l alpha -d 'Weight of the bound (source) channels in matching, 0..1 (paper: 0.85)' -r
 complete -c mo-retarget -l steps -d 'Match-and-blend iterations per pyramid level (paper: 3)' -r
@@ -25,6 +27,8 @@ source\t'The source\'s trajectory, scaled to the target\'s size'"
 complete -c mo-retarget -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-retarget -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-retarget -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-retarget -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-retarget -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-retarget -l emit-binding -d 'Print the binding (JSON) and stop'
 complete -c mo-retarget -l copy-bound -d 'After synthesis, overwrite the bound channels with the source\'s (the paper\'s "directly copy", the reference\'s copy mode): bound joints follow the source exactly'
 complete -c mo-retarget -l report -d 'Print timing, binding, pyramid levels and per-level match cost on stderr'

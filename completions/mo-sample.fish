@@ -6,7 +6,7 @@ complete -c mo-sample -l seconds -d 'Length in seconds (at the skeleton\'s frame
 complete -c mo-sample -l steps -d 'Diffusion steps to visit (1..=100)' -r
 complete -c mo-sample -l sampler -d 'Sampler' -r -f -a "ddpm\t''
 ddim\t''"
-complete -c mo-sample -l bvh -d 'Write BVH files instead of NPY (\'{i}\' becomes the sample index)' -r -F
+complete -c mo-sample -l bvh -d 'Write BVH files instead of NPY (\'{i}\' becomes the sample index); named .glb or .gltf: glTF' -r -F
 complete -c mo-sample -l reference -d 'A clip of the same skeleton (BVH) to keep parts of (needs --keep-frames or --keep-joints)' -r -F
 complete -c mo-sample -l keep-frames -d 'In-betweening: output frames taken from the reference, e.g. \'0-19,100-119\' (inclusive)' -r
 complete -c mo-sample -l keep-joints -d 'Body-part editing: joints taken from the reference: names or globs (\'*Leg*\'), \'Name/\' for a joint and all its descendants, comma-separated' -r
@@ -16,6 +16,8 @@ complete -c mo-sample -l blend -d 'Editing with --smooth: generated frames next 
 complete -c mo-sample -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-sample -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-sample -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-sample -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-sample -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-sample -l report -d 'Print seam continuity as one JSON line on stderr (with --reference), or with --examples the synthesis levels and match costs'
 complete -c mo-sample -l no-plant-feet -d 'Keep the model\'s root travel even where it makes planted feet slide (by default the root\'s horizontal motion follows the feet the model puts on the ground)'
 complete -c mo-sample -s q -l quiet -d 'Print nothing on stderr but errors'

@@ -23,7 +23,7 @@ _mo__segment() {
 
     case "${cmd}" in
         mo__segment)
-            opts="-o -q -v -h -V --k --pca-dims --window --min-segment --features --model --t --layer --draws --restarts --skeleton --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --k --pca-dims --window --min-segment --features --model --t --layer --draws --restarts --skeleton --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -86,6 +86,14 @@ _mo__segment() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -13,6 +13,8 @@ complete -c mo-segment -l skeleton -d 'The input\'s skeleton, a skeleton documen
 complete -c mo-segment -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-segment -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-segment -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-segment -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-segment -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-segment -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-segment -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-segment -s h -l help -d 'Print help (see more with \'--help\')'

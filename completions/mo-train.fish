@@ -23,6 +23,8 @@ complete -c mo-train -l checkpoint-minutes -d 'Save a checkpoint at least this o
 complete -c mo-train -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-train -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-train -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r
+complete -c mo-train -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
+complete -c mo-train -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-train -l resume -d 'Continue from the checkpoint in --out'
 complete -c mo-train -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-train -s v -l verbose -d 'Print more about what is happening on stderr'

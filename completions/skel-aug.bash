@@ -23,7 +23,7 @@ _skel__aug() {
 
     case "${cmd}" in
         skel__aug)
-            opts="-n -o -q -v -h -V --remove-rate --no-remove --add --allow-feet --variants --pretty --output --seed --quiet --verbose --threads --help --version"
+            opts="-n -o -q -v -h -V --remove-rate --no-remove --add --allow-feet --variants --pretty --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -58,6 +58,14 @@ _skel__aug() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

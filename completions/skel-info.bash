@@ -23,7 +23,7 @@ _skel__info() {
 
     case "${cmd}" in
         skel__info)
-            opts="-o -q -v -h -V --format --dmax --pretty --rest-pose --no-anytop --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --format --dmax --pretty --rest-pose --no-anytop --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -54,6 +54,14 @@ _skel__info() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

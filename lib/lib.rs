@@ -12,6 +12,7 @@
 //!
 //! Data types:
 //! * [`bvh`]: our BVH reader and writer (f64 values, exact round trip, file:line errors).
+//! * [`gltf`]: glTF 2.0 / GLB in (a skin and one animation) and out (skin, animation, stick mesh).
 //! * [`skeleton`]: the joint tree, topology (relations, distances, chains), names, sides, feet.
 //! * [`motion`]: per-frame local rotations and translations, Euler channels, forward kinematics.
 //! * [`repr`]: feature tensors of a motion (AnyTop's 13 per joint, Motion2Motion's) and back.
@@ -50,6 +51,7 @@ pub mod dift;
 pub mod document;
 pub mod embed;
 pub mod genmm;
+pub mod gltf;
 pub mod io;
 pub mod linalg;
 pub mod metrics;

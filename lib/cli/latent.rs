@@ -2,8 +2,7 @@
 //! --method latent`: load the SATA model, encode a clip into per-frame latents, decode latents
 //! onto a skeleton.
 
-use crate::bvh;
-use crate::cli::load::{read_skeleton, SkeletonArg};
+use crate::cli::load::{motion_file, read_skeleton, MotionFormat, SkeletonArg};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::io::{self, npy};
@@ -49,7 +48,7 @@ pub fn read_source(path: &Path, model: &Frozen, device: &Device) -> anyhow::Resu
     if bytes.starts_with(b"\x93NUMPY") {
         bail!("{name}: expected a BVH clip to encode, found an NPY file (decode features first: mo-encode --decode)");
     }
-    let parsed = bvh::parse_bytes(&bytes, &name)?;
+    let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
     let skeleton = Skeleton::from_bvh(&parsed);
     skeleton.validate().with_context(|| name.clone())?;
     let motion = Motion::from_bvh(&parsed, &skeleton);
@@ -111,9 +110,18 @@ pub fn latents_npy(latents: &Latents) -> anyhow::Result<Vec<u8>> {
     npy::to_bytes(&[latents.frames, latents.dims], &latents.data).context("building the NPY")
 }
 
-/// Decode onto the target as BVH text, `frame_time` seconds per frame.
-pub fn decode_bvh(model: &Frozen, latents: &Latents, target: &Target, frame_time: f64, device: &Device) -> anyhow::Result<String> {
+/// Decode onto the target, `frame_time` seconds per frame, as the motion file `output` names
+/// (BVH, or glTF by its extension; `stdout` says which on stdout).
+pub fn decode_file(
+    model: &Frozen,
+    latents: &Latents,
+    target: &Target,
+    frame_time: f64,
+    device: &Device,
+    output: Option<&Path>,
+    stdout: MotionFormat,
+) -> anyhow::Result<Vec<u8>> {
     let motion =
         model.decode_motion(latents, &target.fitted, &target.prepared, frame_time, device).with_context(|| format!("decoding onto {}", target.arg.name))?;
-    Ok(bvh::write_string(&motion.to_bvh(&target.arg.skeleton)))
+    motion_file(&target.arg.skeleton, &motion, output, stdout)
 }

@@ -1,5 +1,7 @@
-//! Reading motion for the tools that consume it: BVH files, or NPY feature tensors decoded on a
-//! skeleton (a skeleton document, or a BVH standing for the document `skel-info` prints).
+//! Reading motion for the tools that consume it: BVH files, glTF/GLB files, or NPY feature
+//! tensors decoded on a skeleton (a skeleton document, or a BVH standing for the document
+//! `skel-info` prints). A glTF file is read as the BVH it stands for (`parse_motion`), so every
+//! tool that reads BVH reads glTF through this one door, and writes it through `motion_bytes`.
 //!
 //! `mo-encode --decode` and every tool that *looks at* motion (`mo-render`, `mo-metrics`) go
 //! through the same code here, so an NPY decodes to the same joint positions everywhere.
@@ -10,10 +12,99 @@ use crate::motion::Motion;
 use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, IkOptions, Placement, RestSource};
 use crate::repr::{m2m, Features};
 use crate::skeleton::{topology, Skeleton};
-use crate::{bvh, io};
+use crate::{bvh, gltf, io};
 use anyhow::{anyhow, bail, Context};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// The glTF input options of this run (`--animation`, `--fps`), set once from `CommonOpts`.
+static GLTF_OPTIONS: Mutex<Option<gltf::ReadOptions>> = Mutex::new(None);
+
+/// Set how glTF inputs are read for the rest of the process.
+pub fn set_gltf_options(options: gltf::ReadOptions) {
+    *GLTF_OPTIONS.lock().unwrap_or_else(|e| e.into_inner()) = Some(options);
+}
+
+fn gltf_options() -> gltf::ReadOptions {
+    GLTF_OPTIONS.lock().unwrap_or_else(|e| e.into_inner()).clone().unwrap_or_default()
+}
+
+/// Whether `bytes` from `path` are glTF: GLB's magic, a `.gltf`/`.glb` name, or JSON with the
+/// `asset` object every glTF has (a glTF piped on stdin).
+pub fn is_gltf(path: &Path, bytes: &[u8]) -> bool {
+    #[derive(serde::Deserialize)]
+    struct Probe {
+        asset: Option<serde::de::IgnoredAny>,
+    }
+    gltf::looks_like_gltf(path, bytes)
+        || (bytes.trim_ascii_start().starts_with(b"{") && serde_json::from_slice::<Probe>(bytes).is_ok_and(|p| p.asset.is_some()))
+}
+
+/// The skeleton and motion of a glTF file (`--animation`, `--fps` as given for this run).
+pub fn read_gltf(bytes: &[u8], name: &str, path: &Path) -> anyhow::Result<(Skeleton, Motion)> {
+    let base = if is_dash(path) { None } else { Some(path.parent().unwrap_or(Path::new("."))) };
+    Ok(gltf::read(bytes, name, base, &gltf_options())?)
+}
+
+/// A motion file as BVH data: BVH parsed as it is, glTF (by name or content) as the BVH it
+/// stands for (ZXY rotation channels, positions on the root and on joints that translate).
+pub fn parse_motion(bytes: &[u8], name: &str, path: &Path) -> anyhow::Result<bvh::Bvh> {
+    if is_gltf(path, bytes) {
+        let (skeleton, motion) = read_gltf(bytes, name, path)?;
+        Ok(motion.to_bvh(&skeleton))
+    } else {
+        Ok(bvh::parse_bytes(bytes, name)?)
+    }
+}
+
+/// The motion file formats tools write.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MotionFormat {
+    Bvh,
+    /// Binary glTF: skin, animation and a stick mesh in one file (Blender, three.js, game engines).
+    Glb,
+    /// glTF JSON with the binary data inlined.
+    Gltf,
+}
+
+impl MotionFormat {
+    /// What a path's extension asks for (`.glb`, `.gltf`; anything else is BVH).
+    pub fn of_path(path: &Path) -> MotionFormat {
+        match path.extension().and_then(|x| x.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("glb") => MotionFormat::Glb,
+            Some("gltf") => MotionFormat::Gltf,
+            _ => MotionFormat::Bvh,
+        }
+    }
+
+    /// The format for an output: the path's extension, or `stdout` for stdout (`None` or `-`).
+    pub fn for_output(path: Option<&Path>, stdout: MotionFormat) -> MotionFormat {
+        match path {
+            Some(p) if !is_dash(p) => MotionFormat::of_path(p),
+            _ => stdout,
+        }
+    }
+}
+
+/// The bytes of a motion file in `format`; `name` is the output's, for messages.
+pub fn motion_bytes(skeleton: &Skeleton, motion: &Motion, format: MotionFormat, name: &str) -> anyhow::Result<Vec<u8>> {
+    Ok(match format {
+        MotionFormat::Bvh => bvh::write_string(&motion.to_bvh(skeleton)).into_bytes(),
+        MotionFormat::Glb => gltf::write_glb(skeleton, motion, name)?,
+        MotionFormat::Gltf => gltf::write_gltf(skeleton, motion, name)?,
+    })
+}
+
+/// A motion written to `path` (or stdout as `stdout` says), in the format the path asks for.
+pub fn motion_file(skeleton: &Skeleton, motion: &Motion, path: Option<&Path>, stdout: MotionFormat) -> anyhow::Result<Vec<u8>> {
+    let name = path.filter(|p| !is_dash(p)).map_or_else(|| "<stdout>".to_string(), |p| p.display().to_string());
+    let format = MotionFormat::for_output(path, stdout);
+    if format == MotionFormat::Glb {
+        io::refuse_terminal(path, "binary glTF", "give -o FILE.glb or redirect stdout")?;
+    }
+    motion_bytes(skeleton, motion, format, &name)
+}
 
 /// Where AnyTop decoding takes the rotations from.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,7 +137,13 @@ pub fn read_skeleton(path: &Path) -> anyhow::Result<SkeletonArg> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read skeleton {name}"))?;
     let body = bytes.strip_prefix(b"\xEF\xBB\xBF".as_slice()).unwrap_or(&bytes).trim_ascii_start();
-    if body.starts_with(b"{") {
+    if is_gltf(path, &bytes) {
+        let parsed = parse_motion(&bytes, &name, path)?;
+        let skeleton = Skeleton::from_bvh(&parsed);
+        let document = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, topology::DEFAULT_DMAX);
+        let motion = Some(Motion::from_bvh(&parsed, &skeleton));
+        Ok(SkeletonArg { tpose: !is_dash(path) && anytop::names_tpose(&path.to_string_lossy()), name, skeleton, document, motion })
+    } else if body.starts_with(b"{") {
         let text = std::str::from_utf8(body).with_context(|| format!("{name}: skeleton document is not UTF-8"))?;
         let document = SkeletonDocument::from_json(text).with_context(|| name.clone())?;
         let skeleton = document.skeleton().with_context(|| name.clone())?;
@@ -60,7 +157,7 @@ pub fn read_skeleton(path: &Path) -> anyhow::Result<SkeletonArg> {
         Ok(SkeletonArg { tpose: !is_dash(path) && anytop::names_tpose(&path.to_string_lossy()), name, skeleton, document, motion })
     } else {
         let start: String = body.iter().take(12).flat_map(|&b| std::ascii::escape_default(b)).map(char::from).collect();
-        bail!("{name}: not a skeleton: expected a skeleton document (JSON from skel-info) or a BVH file, found '{start}'")
+        bail!("{name}: not a skeleton: expected a skeleton document (JSON from skel-info), a BVH or a glTF file, found '{start}'")
     }
 }
 
@@ -218,8 +315,8 @@ pub struct LoadOptions<'a> {
     pub from: Option<DecodeFrom>,
 }
 
-/// Files named by the command line: files as given, directories as the BVH and NPY files
-/// directly inside them (sorted by name, so the order never depends on the file system).
+/// Files named by the command line: files as given, directories as the BVH, glTF (`.gltf`,
+/// `.glb`) and NPY files directly inside them (sorted by name, so the order never depends on the file system).
 pub fn expand_inputs(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for input in inputs {
@@ -227,10 +324,10 @@ pub fn expand_inputs(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
             let entries = std::fs::read_dir(input).with_context(|| format!("cannot list {}", input.display()))?;
             let mut files: Vec<PathBuf> = entries
                 .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.is_file() && p.extension().is_some_and(|x| x.eq_ignore_ascii_case("bvh") || x.eq_ignore_ascii_case("npy")))
+                .filter(|p| p.is_file() && p.extension().is_some_and(|x| ["bvh", "npy", "glb", "gltf"].iter().any(|e| x.eq_ignore_ascii_case(e))))
                 .collect();
             if files.is_empty() {
-                bail!("{}: the directory holds no .bvh or .npy files", input.display());
+                bail!("{}: the directory holds no .bvh, .glb, .gltf or .npy files", input.display());
             }
             files.sort();
             out.extend(files);
@@ -256,9 +353,9 @@ pub fn read_bvh_clip(path: &Path, tool: &str) -> anyhow::Result<BvhClip> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
     if npy::looks_like_npy(path, &bytes) {
-        bail!("{name}: {tool} reads BVH files (decode features first: mo-encode --decode)");
+        bail!("{name}: {tool} reads BVH or glTF files (decode features first: mo-encode --decode)");
     }
-    let parsed = bvh::parse_bytes(&bytes, &name)?;
+    let parsed = parse_motion(&bytes, &name, path)?;
     let skeleton = Skeleton::from_bvh(&parsed);
     skeleton.validate().with_context(|| name.clone())?;
     let motion = Motion::from_bvh(&parsed, &skeleton);
@@ -305,7 +402,7 @@ pub fn load_motions(inputs: &[PathBuf], options: &LoadOptions) -> anyhow::Result
             drop(bytes);
             decode_npy(array, &name, arg, options.from.unwrap_or(DecodeFrom::Rotations))
         } else {
-            let parsed = bvh::parse_bytes(&bytes, &name)?;
+            let parsed = parse_motion(&bytes, &name, path)?;
             drop(bytes);
             let skeleton = Skeleton::from_bvh(&parsed);
             skeleton.validate().with_context(|| name.clone())?;

@@ -21,15 +21,15 @@
 //! error never leaves a partial output.
 
 use crate::cli::load::{is_dash, read_skeleton, split_samples, Decoder, SkeletonArg};
-pub use crate::cli::load::{load_skeleton, DecodeFrom};
+pub use crate::cli::load::{load_skeleton, DecodeFrom, MotionFormat};
 use crate::cli::CommonOpts;
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
+use crate::io;
 use crate::io::npy;
 use crate::motion::Motion;
 use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource};
 use crate::repr::{m2m, Features};
 use crate::skeleton::{lookup, topology, Skeleton};
-use crate::{bvh, io};
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -279,7 +279,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         let target = super::latent::read_target(skeleton, &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.arg.name, &target.arg.skeleton, args.common.quiet)?;
         let frame_time = target.arg.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
-        super::latent::decode_bvh(&model, &latents, &target, frame_time, &device)?.into_bytes()
+        super::latent::decode_file(&model, &latents, &target, frame_time, &device, args.common.output.as_deref(), MotionFormat::Bvh)?
     };
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
@@ -349,7 +349,7 @@ struct Clip {
 fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<Clip> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-    let parsed = bvh::parse_bytes(&bytes, &name)?;
+    let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
     drop(bytes);
     let skeleton = Skeleton::from_bvh(&parsed);
     let motion = Motion::from_bvh_frames(&parsed, &skeleton, 0..frames.unwrap_or(usize::MAX));
@@ -792,17 +792,17 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         (0..samples.len()).map(|i| io::numbered_output(pattern, i, samples.len()).map(Some).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?
     };
 
-    let texts: Vec<anyhow::Result<String>> = samples
+    let texts: Vec<anyhow::Result<Vec<u8>>> = samples
         .par_iter()
         .enumerate()
         .map(|(i, f)| {
             let motion = decoder.decode(i, f, skeleton).map_err(|e| anyhow!("{}: {e}", label(i)))?;
-            Ok(bvh::write_string(&motion.to_bvh(skeleton)))
+            crate::cli::load::motion_file(skeleton, &motion, paths[i].as_deref(), MotionFormat::Bvh)
         })
         .collect();
-    let texts = texts.into_iter().collect::<anyhow::Result<Vec<String>>>()?;
+    let texts = texts.into_iter().collect::<anyhow::Result<Vec<Vec<u8>>>>()?;
     if args.common.verbose {
         eprintln!("mo-encode: {name}: {} sample(s) of {} frames decoded on {}", samples.len(), samples.first().map_or(0, |f| f.frames), arg.name);
     }
-    write_outputs(paths.into_iter().zip(texts.into_iter().map(String::into_bytes)).collect())
+    write_outputs(paths.into_iter().zip(texts).collect())
 }

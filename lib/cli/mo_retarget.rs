@@ -5,9 +5,8 @@
 
 use crate::binding::auto::{self, AutoOptions, Body};
 use crate::binding::{Binding, JointMap};
-use crate::bvh;
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, BvhClip};
+use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips, BvhClip, MotionFormat};
 use crate::cli::CommonOpts;
 use crate::document::AnyTopSection;
 use crate::io::{self, npy};
@@ -26,11 +25,12 @@ EXAMPLES:
     mo-retarget examples/data/quadruped.bvh examples/data/dragon.bvh --bind auto -n 3 -o 'd_{i}.bvh'
     mo-retarget examples/data/biped.bvh examples/data/biped.bvh --bind auto --seconds 2 -o b.bvh
     cat examples/data/spider.bvh | mo-retarget - examples/data/crab.bvh --bind auto --format npy
-    mo-retarget --method latent examples/data/biped.bvh --to examples/data/quadruped.bvh -o q.bvh";
+    mo-retarget --method latent examples/data/biped.bvh --to examples/data/quadruped.bvh -o q.bvh
+    mo-retarget examples/data/quadruped.bvh examples/data/dragon.bvh --bind auto -o dragon.glb";
 
 /// Transfer a motion to a different skeleton from a few example clips of it (Motion2Motion).
 ///
-/// SOURCE is a BVH (path or '-'); TARGETS are example clips of the target skeleton (BVH files
+/// SOURCE is a BVH or glTF (path or '-'); TARGETS are example clips of the target skeleton (BVH or glTF files
 /// or directories of them; all must share one skeleton). No training: the result is stitched
 /// from patches of the examples, chosen coarse-to-fine so that the bound joints follow the
 /// source and everything else moves like the examples do.
@@ -98,7 +98,7 @@ pub struct Args {
     /// Key-frame mode: the source counts only at these frames (comma-separated, source frames).
     #[arg(long, value_name = "F,F,...", value_delimiter = ',')]
     pub key_frames: Option<Vec<usize>>,
-    /// Output format.
+    /// Output format on stdout: BVH, glTF (glb: binary, gltf: JSON) or Motion2Motion features (npy). An -o file named .glb or .gltf is written as glTF.
     #[arg(long, value_enum, default_value_t = OutFormat::Bvh)]
     pub format: OutFormat,
     /// Patch length in frames (paper: 11).
@@ -142,7 +142,23 @@ pub enum Method {
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OutFormat {
     Bvh,
+    /// Binary glTF (skin, animation, a stick mesh).
+    Glb,
+    /// glTF JSON, data inlined.
+    Gltf,
+    /// Motion2Motion features.
     Npy,
+}
+
+impl OutFormat {
+    /// The motion file format on stdout (`--format npy` has none).
+    fn motion(self) -> MotionFormat {
+        match self {
+            OutFormat::Glb => MotionFormat::Glb,
+            OutFormat::Gltf => MotionFormat::Gltf,
+            OutFormat::Bvh | OutFormat::Npy => MotionFormat::Bvh,
+        }
+    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -206,7 +222,7 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
         known.warn("mo-retarget", name, skeleton, args.common.quiet)?;
     }
     let latents = super::latent::encode(&model, &source, &device)?;
-    let text = super::latent::decode_bvh(&model, &latents, &target, source.motion.frame_time, &device)?;
+    let bytes = super::latent::decode_file(&model, &latents, &target, source.motion.frame_time, &device, args.common.output.as_deref(), args.format.motion())?;
     if args.report {
         eprintln!(
             "mo-retarget: latent: {} ({} joints) -> {} ({} joints), {} frames, latent {} per frame, {:.2} s",
@@ -219,7 +235,7 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
             started.elapsed().as_secs_f64()
         );
     }
-    Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
+    Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
 
 type Clip = BvhClip;
@@ -318,7 +334,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             (0..count).map(|i| io::numbered_output(p, i, count).map(Some).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?
         }
         Some(p) if !is_dash(p) => vec![Some(p.to_path_buf())],
-        _ if count > 1 && args.format == OutFormat::Bvh && !args.emit_binding => {
+        _ if count > 1 && args.format != OutFormat::Npy && !args.emit_binding => {
             bail!("{count} samples need a numbered output path such as -o 'out_{{i}}.bvh' (or --format npy for one batch)")
         }
         _ => vec![None],
@@ -399,9 +415,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let t1 = Instant::now();
     let mut files: Vec<(Option<PathBuf>, Vec<u8>)> = Vec::new();
     match args.format {
-        OutFormat::Bvh => {
+        OutFormat::Bvh | OutFormat::Glb | OutFormat::Gltf => {
             for (r, out) in results.iter().zip(&outputs) {
-                files.push((out.clone(), bvh::write_string(&r.motion.to_bvh(&first.skeleton)).into_bytes()));
+                files.push((out.clone(), motion_file(&first.skeleton, &r.motion, out.as_deref(), args.format.motion())?));
             }
         }
         OutFormat::Npy => {

@@ -1,7 +1,6 @@
 //! `mo-sample`: generate motion for any skeleton with a trained denoiser, or from a few example
 //! clips of it without a model (`--examples`, in `mo_sample_examples`).
 
-use crate::bvh;
 use crate::cli::load::read_skeleton;
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
@@ -139,7 +138,7 @@ pub struct Args {
     /// Sampler.
     #[arg(long, value_enum, default_value_t = SamplerArg::Ddim)]
     pub sampler: SamplerArg,
-    /// Write BVH files instead of NPY ('{i}' becomes the sample index).
+    /// Write BVH files instead of NPY ('{i}' becomes the sample index); named .glb or .gltf: glTF.
     #[arg(long, value_name = "PATTERN")]
     pub bvh: Option<PathBuf>,
     /// A clip of the same skeleton (BVH) to keep parts of (needs --keep-frames or --keep-joints).
@@ -289,10 +288,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let mut texts = Vec::with_capacity(count);
             for (i, f) in samples.iter().enumerate() {
                 let motion = section.rig.decode_ik(skeleton, f, &placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
-                texts.push(bvh::write_string(&motion.to_bvh(skeleton)));
+                texts.push(crate::cli::load::motion_file(skeleton, &motion, Some(&paths[i]), crate::cli::load::MotionFormat::Bvh)?);
             }
             // All samples or none.
-            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_bytes())).collect::<Vec<_>>())?;
+            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_slice())).collect::<Vec<_>>())?;
         }
         None => {
             io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
@@ -329,7 +328,7 @@ fn read_reference(
 ) -> anyhow::Result<Reference> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read the reference {name}"))?;
-    let parsed = bvh::parse_bytes(&bytes, &name).with_context(|| format!("the reference {name}"))?;
+    let parsed = crate::cli::load::parse_motion(&bytes, &name, path).with_context(|| format!("the reference {name}"))?;
     let own = crate::skeleton::Skeleton::from_bvh(&parsed);
     own.validate().with_context(|| name.clone())?;
     if let Some(diff) = skeleton.first_difference(&own) {

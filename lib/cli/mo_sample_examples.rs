@@ -4,7 +4,6 @@
 //! writes BVH on the examples' skeleton or Motion2Motion features, all outputs or none.
 
 use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
-use crate::bvh;
 use crate::cli::bounds;
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton, BvhClip};
 use crate::diffusion::edit;
@@ -85,9 +84,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     match outputs {
         Some(paths) => {
-            let texts: Vec<String> = generated.iter().map(|g| bvh::write_string(&g.motion.to_bvh(skeleton))).collect();
+            let texts = generated
+                .iter()
+                .zip(&paths)
+                .map(|(g, p)| crate::cli::load::motion_file(skeleton, &g.motion, Some(p), crate::cli::load::MotionFormat::Bvh))
+                .collect::<anyhow::Result<Vec<Vec<u8>>>>()?;
             // All samples or none.
-            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_bytes())).collect::<Vec<_>>())?;
+            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_slice())).collect::<Vec<_>>())?;
         }
         None => {
             io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;

@@ -4,7 +4,6 @@
 //! (`frame_features`: the place where feature providers plug in), runs `segment::segment`, and
 //! writes JSON that `mo-render --frame-labels` reads.
 
-use crate::bvh;
 use crate::cli::bounds;
 use crate::cli::load::{is_dash, read_skeleton, split_samples};
 use crate::cli::CommonOpts;
@@ -272,7 +271,7 @@ fn load(args: &Args) -> anyhow::Result<Input> {
         None => None,
     };
     if !npy::looks_like_npy(&args.input, &bytes) {
-        let parsed = bvh::parse_bytes(&bytes, &name)?;
+        let parsed = crate::cli::load::parse_motion(&bytes, &name, &args.input)?;
         drop(bytes);
         let own = Skeleton::from_bvh(&parsed);
         own.validate().with_context(|| name.clone())?;

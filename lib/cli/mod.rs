@@ -44,13 +44,25 @@ pub struct CommonOpts {
     /// Worker threads (default: all cores; at most 256). Output never depends on this.
     #[arg(long, value_name = "N", global = true, value_parser = bounds::count(1, bounds::MAX_THREADS))]
     pub threads: Option<usize>,
+    /// glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first).
+    #[arg(long, value_name = "NAME|INDEX", global = true)]
+    pub animation: Option<String>,
+    /// glTF inputs: sample the animation at this frame rate (default: at its keyframe times).
+    #[arg(long, value_name = "FPS", global = true, value_parser = bounds::positive(1000.0))]
+    pub fps: Option<f64>,
 }
 
 impl CommonOpts {
     /// Apply `--threads` to rayon's global pool, once per process (later calls, as in tests
     /// that run tools in one process, return the first one's result). A pool that cannot be
-    /// built is an error: rayon would panic at its first use afterwards.
+    /// built is an error: rayon would panic at its first use afterwards. Also hands the glTF
+    /// input options to the one loader (`load::set_gltf_options`).
     pub fn init_threads(&self) -> anyhow::Result<()> {
+        load::set_gltf_options(crate::gltf::ReadOptions {
+            animation: self.animation.as_deref().map_or(crate::gltf::AnimationChoice::First, crate::gltf::AnimationChoice::parse),
+            fps: self.fps,
+            max_frames: bounds::MAX_FRAMES,
+        });
         static BUILT: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
         let Some(n) = self.threads else { return Ok(()) };
         let built = BUILT.get_or_init(|| rayon::ThreadPoolBuilder::new().num_threads(n).build_global().map_err(|e| e.to_string()));

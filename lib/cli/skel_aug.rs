@@ -19,11 +19,12 @@ EXAMPLES:
     skel-aug examples/data/spider.bvh --no-remove --add 5 | skel-info - --format text
     skel-info examples/data/quadruped.bvh | skel-aug --seed 7 --pretty
     skel-aug examples/data/snake.bvh --allow-feet --remove-rate 0.2 -o snake_short.bvh
-    cat examples/data/crab.bvh | skel-aug -n 3 -o 'crab_{i}.bvh'";
+    cat examples/data/crab.bvh | skel-aug -n 3 -o 'crab_{i}.bvh'
+    skel-aug examples/data/crab.bvh --no-remove -o crab.glb";
 
 /// Augment a skeleton: remove end-effector chains, subdivide bones, keep the motion exact.
 ///
-/// Reads one BVH file or skeleton document (JSON, recognised by a leading '{') and writes the
+/// Reads one BVH (or glTF) file or skeleton document (JSON, recognised by a leading '{') and writes the
 /// same kind back with a changed skeleton (AnyTop's skeletal augmentation, done as a real
 /// edit of the hierarchy):
 ///
@@ -95,11 +96,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     let name = io::display_name(&args.input);
     let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
-    let input = if looks_like_json(&bytes) {
+    let input = if crate::cli::load::is_gltf(&args.input, &bytes) {
+        Input::Bvh(crate::cli::load::parse_motion(&bytes, &name, &args.input)?)
+    } else if looks_like_json(&bytes) {
         let text = std::str::from_utf8(&bytes).map_err(|e| anyhow::anyhow!("{name}: not UTF-8 text: {e}"))?;
         Input::Document(Box::new(SkeletonDocument::from_json(text).with_context(|| name.clone())?))
     } else {
-        Input::Bvh(bvh::parse_bytes(&bytes, &name)?)
+        Input::Bvh(crate::cli::load::parse_motion(&bytes, &name, &args.input)?)
     };
     // Every variant is held until all are written (all or nothing); each has its frames.
     crate::budget::check("the variants' text", count as u128 * (bytes.len() as u128 + 64 * args.add as u128), 2)?;
@@ -128,7 +131,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             eprint!("{}", describe(&plan, &name, &target));
         }
         let text = match &input {
-            Input::Bvh(b) => bvh::write_string(&plan.apply_bvh(b)),
+            Input::Bvh(b) => {
+                let edited = plan.apply_bvh(b);
+                let format = crate::cli::load::MotionFormat::for_output(out.as_deref(), crate::cli::load::MotionFormat::Bvh);
+                if format == crate::cli::load::MotionFormat::Bvh {
+                    bvh::write_string(&edited).into_bytes()
+                } else {
+                    let skeleton = Skeleton::from_bvh(&edited);
+                    let motion = crate::motion::Motion::from_bvh(&edited, &skeleton);
+                    crate::cli::load::motion_file(&skeleton, &motion, out.as_deref(), format)?
+                }
+            }
             Input::Document(d) => {
                 let source = format!("{} (skel-aug --seed {} variant {i})", d.source, args.common.seed);
                 let motion = if plan.is_empty() { d.motion.clone() } else { None };
@@ -136,13 +149,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 let mut json =
                     if args.pretty { serde_json::to_string_pretty(&doc) } else { serde_json::to_string(&doc) }.context("serialising the skeleton document")?;
                 json.push('\n');
-                json
+                json.into_bytes()
             }
         };
         texts.push(text);
     }
     // All variants or none.
-    let files: Vec<(Option<&Path>, &[u8])> = outputs.iter().zip(&texts).map(|(p, t)| (p.as_deref(), t.as_bytes())).collect();
+    let files: Vec<(Option<&Path>, &[u8])> = outputs.iter().zip(&texts).map(|(p, t)| (p.as_deref(), t.as_slice())).collect();
     Ok(io::write_all(&files)?)
 }
 

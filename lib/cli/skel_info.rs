@@ -70,7 +70,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Some(path) => {
             let name = io::display_name(path);
             let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-            let parsed = bvh::parse_bytes(&bytes, &name)?;
+            let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
             if parsed.frames == 0 {
                 anyhow::bail!("--rest-pose {name}: the file has no frames (the rest pose is its frame 0)");
             }
@@ -83,7 +83,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for path in &args.inputs {
         let name = io::display_name(path);
         let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-        let parsed = bvh::parse_bytes(&bytes, &name)?;
+        let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
         let skeleton = Skeleton::from_bvh(&parsed);
         let mut doc = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, args.dmax as usize);
         if !args.no_anytop {

@@ -8,6 +8,7 @@ mod bvh_corpus;
 mod common;
 mod fk_reference;
 mod generated_docs;
+mod gltf_io;
 mod help_examples;
 mod latent_cli;
 mod malformed;

@@ -97,7 +97,7 @@ fn bad_inputs_exit_2_with_one_line_and_no_output() {
             vec!["--examples", s(&crab), "--reference", s(&crab), "--frames", "100", "--keep-frames", "60-70", "--bvh", o],
             "--keep-frames",
         ),
-        ("NPY clip", vec!["--examples", s(&npy_file), "--bvh", o], "f.npy: mo-sample --examples reads BVH files"),
+        ("NPY clip", vec!["--examples", s(&npy_file), "--bvh", o], "f.npy: mo-sample --examples reads BVH or glTF files"),
         ("directory without clips", vec!["--examples", s(&empty), "--bvh", o], "holds no .bvh"),
         ("broken BVH", vec!["--examples", s(&broken), "--bvh", o], "broken.bvh"),
         ("missing clip", vec!["--examples", "nowhere.bvh", "--bvh", o], "nowhere.bvh"),
