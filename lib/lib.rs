@@ -47,6 +47,7 @@ pub mod bvh;
 pub mod cli;
 pub mod diffusion;
 pub mod dift;
+pub mod correspond;
 pub mod document;
 pub mod embed;
 pub mod genmm;

@@ -19,10 +19,10 @@
 //! and `Left Shoulder` apart) and lower-case words are capitalised.
 
 /// Rig prefixes that carry no meaning, dropped while they lead the name.
-const RIG_PREFIXES: &[&str] =
+pub(crate) const RIG_PREFIXES: &[&str] =
     &["bip01", "bip001", "bip", "bn", "npc", "jt", "org", "def", "mch", "joint", "jnt", "bone", "mixamorig", "sabrecat", "elk", "cc", "base", "rig"];
 
-const JAPANESE: &[(&str, &str)] = &[
+pub(crate) const JAPANESE: &[(&str, &str)] = &[
     ("momo", "Thigh"),
     ("sippo", "Tail"),
     ("mune", "Chest"),
@@ -39,7 +39,7 @@ const JAPANESE: &[(&str, &str)] = &[
 ];
 
 /// Body words recognised after a glued side letter (`lhand`, `rfoot`, `lshoulder`).
-const GLUED_SIDE_WORDS: &[&str] = &[
+pub(crate) const GLUED_SIDE_WORDS: &[&str] = &[
     "hand", "foot", "arm", "leg", "shoulder", "hip", "knee", "elbow", "wrist", "ankle", "toe", "toes", "thigh", "finger", "fingers", "thumb", "collar",
     "clavicle", "upleg", "forearm", "uparm", "wing", "eye", "ear",
 ];
