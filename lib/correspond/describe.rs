@@ -11,6 +11,7 @@
 use super::names::{self as keys, LimbWord, NameKey};
 use crate::skeleton::names::{self, Side};
 use crate::skeleton::{roles, Skeleton};
+
 use glam::DVec3;
 
 /// Which limb pair a joint belongs to.
@@ -43,22 +44,39 @@ pub struct Described {
     pub leaf: Vec<bool>,
     /// Some joint has a side.
     pub has_sides: bool,
+    /// Sides (and limb pairs) come from the names; otherwise from the rest pose.
+    pub named_sides: bool,
 }
 
-/// Describe `skeleton` with rest positions `rest` (facing +z, y up). With `use_names` false,
-/// names are ignored: sides and limbs come from geometry alone.
-pub fn describe(skeleton: &Skeleton, rest: &[DVec3], use_names: bool) -> Described {
+/// Where sides and limb pairs come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Roles {
+    /// Names where they say, the rest pose otherwise (`roles::sides`, limb words).
+    Names,
+    /// The rest pose alone (`roles::sides` without names; front is up or forward). Two
+    /// skeletons compare in this view when either one's names are silent: a named side and a
+    /// geometric side need not agree on rigs whose rest pose is not the BVH convention.
+    Geometry,
+}
+
+/// Describe `skeleton` with rest positions `rest` (facing +z, y up). `use_names` false leaves
+/// the name keys blank; `roles` says where sides and limb pairs come from.
+pub fn describe(skeleton: &Skeleton, rest: &[DVec3], use_names: bool, roles: Roles) -> Described {
     let n = skeleton.len();
     let parents = skeleton.parents();
     let children = skeleton.children();
     let keys: Vec<NameKey> = skeleton.joints.iter().map(|j| if use_names { keys::key(&j.name) } else { NameKey::default() }).collect();
-    let normalised: Vec<String> = skeleton.joints.iter().map(|j| if use_names { names::normalise(&j.name) } else { String::new() }).collect();
-    let side = roles::sides(skeleton, &normalised);
-    let has_sides = side.iter().any(|s| *s != Side::Centre);
     let root = rest.first().copied().unwrap_or(DVec3::ZERO);
     let (lo, hi) = rest.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let size = if n == 0 { 1.0 } else { (hi - lo).max_element().max(1e-9) };
     let place: Vec<DVec3> = rest.iter().map(|p| (*p - root) / size).collect();
+    let normalised: Vec<String> = skeleton.joints.iter().map(|j| names::normalise(&j.name)).collect();
+    let named_sides = normalised.iter().any(|s| names::side_from_name(s).is_some());
+    let side = match roles {
+        Roles::Names => roles::sides(skeleton, &normalised),
+        Roles::Geometry => roles::sides(skeleton, &vec![String::new(); n]),
+    };
+    let has_sides = side.iter().any(|s| *s != Side::Centre);
     let direction = (0..n)
         .map(|j| match parents[j] {
             Some(p) => (rest[j] - rest[p]).try_normalize().unwrap_or(DVec3::ZERO),
@@ -108,10 +126,11 @@ pub fn describe(skeleton: &Skeleton, rest: &[DVec3], use_names: bool) -> Describ
         })
         .collect();
     let bases: Vec<usize> = (0..n).filter(|&j| base[j] == j).collect();
-    let class_of_base = limb_classes(&bases, &base, &keys, &side, &place, n);
+    let limb_keys: &[NameKey] = if roles == Roles::Names { &keys } else { &[] };
+    let class_of_base = limb_classes(&bases, &base, limb_keys, &side, &place, n);
     let limb = (0..n).map(|j| if base[j] == usize::MAX { Limb::Centre } else { class_of_base[base[j]] }).collect();
     let leaf = children.iter().map(Vec::is_empty).collect();
-    Described { keys, side, limb, along, place, direction, signature, parents, leaf, has_sides }
+    Described { keys, side, limb, along, place, direction, signature, parents, leaf, has_sides, named_sides }
 }
 
 /// Front or hind for every limb base (indexed by joint): by names when the names tell the
@@ -120,7 +139,7 @@ fn limb_classes(bases: &[usize], base: &[usize], keys: &[NameKey], side: &[Side]
     let mut out = vec![Limb::Unknown; n];
     // Votes of every joint's words in each limb.
     let mut votes = vec![(0usize, 0usize); n];
-    for j in 0..n {
+    for j in 0..keys.len().min(n) {
         if base[j] == usize::MAX {
             continue;
         }

@@ -24,7 +24,7 @@ pub mod names;
 
 use crate::skeleton::names::Side;
 use crate::skeleton::Skeleton;
-use describe::{describe, Described, Limb};
+use describe::{describe, Described, Limb, Roles};
 use glam::DVec3;
 
 /// One skeleton: its joints and rest positions facing +z, y up (`AnyTopRig::rest_positions`).
@@ -115,8 +115,11 @@ pub fn scores(source: &Body, target: &Body, evidence: Evidence, extra: Option<&[
             return Err(CorrespondError::ExtraSize { rows: x.len(), cols: x.first().map_or(0, Vec::len), source_joints: ns, target_joints: nt });
         }
     }
-    let a = describe(source.skeleton, source.rest, evidence.names);
-    let b = describe(target.skeleton, target.rest, evidence.names);
+    // Sides and limb pairs from names only when both skeletons name their sides.
+    let named = |body: &Body| evidence.names && describe(body.skeleton, body.rest, true, Roles::Names).named_sides;
+    let roles = if named(source) && named(target) { Roles::Names } else { Roles::Geometry };
+    let a = describe(source.skeleton, source.rest, evidence.names, roles);
+    let b = describe(target.skeleton, target.rest, evidence.names, roles);
     let score = (0..ns).map(|s| (0..nt).map(|t| pair_score(&a, s, &b, t, evidence).map(|v| v + extra.map_or(0.0, |x| EXTRA_WEIGHT * x[s][t]))).collect()).collect();
     Ok(Scores { source: a, target: b, score })
 }
@@ -304,7 +307,7 @@ mod tests {
     fn spider_and_centipede_legs_keep_their_numbers_and_pairs() {
         for name in ["spider", "centipede"] {
             let (s, rest) = body_of(name);
-            let d = describe(&s, &rest, true);
+            let d = describe(&s, &rest, true, Roles::Names);
             let legs: Vec<usize> = (0..s.len()).filter(|&j| d.side[j] == Side::Left && d.keys[j].words.contains(&"leg".to_string())).collect();
             let mut ordinals: Vec<u64> = legs.iter().flat_map(|&j| d.keys[j].ordinals.clone()).collect();
             ordinals.sort();

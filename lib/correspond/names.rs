@@ -22,6 +22,10 @@ pub struct NameKey {
     pub words: Vec<String>,
     /// Numbers in the name after the rig prefix, in order (`leg_l1_coxa` -> [1]).
     pub ordinals: Vec<u64>,
+    /// The whole name in lower case, without namespace and Truebones suffix: two joints whose
+    /// keys agree but whose spellings differ (Rigify's `ORG_Pelvis` and `DEF_Pelvis`) are told
+    /// apart by it.
+    pub spelling: String,
 }
 
 impl NameKey {
@@ -40,8 +44,6 @@ const SYNONYMS: &[(&str, &str)] = &[
     ("toes", "toe"),
     ("fingers", "finger"),
     ("collar", "clavicle"),
-    ("pelvis", "hips"),
-    ("hip", "hips"),
 ];
 
 /// Words of the front limbs (arms, wings) and of the hind limbs (legs).
@@ -59,6 +61,7 @@ pub enum LimbWord {
 /// The key of a raw joint name.
 pub fn key(raw: &str) -> NameKey {
     let mut words = split_words(raw);
+    let spelling = words.join("_").to_ascii_lowercase();
     while words.len() > 1 {
         let w = words[0].to_ascii_lowercase();
         if RIG_PREFIXES.contains(&w.as_str()) || w.chars().all(|c| c.is_ascii_digit()) {
@@ -67,7 +70,7 @@ pub fn key(raw: &str) -> NameKey {
             break;
         }
     }
-    let mut out = NameKey::default();
+    let mut out = NameKey { spelling, ..NameKey::default() };
     let mut body: Vec<String> = Vec::new();
     for w in &words {
         let lower = w.to_ascii_lowercase();
@@ -138,15 +141,15 @@ pub fn limb_word(key: &NameKey) -> Option<LimbWord> {
     })
 }
 
-/// How alike two names are, 0..1: 1 for the same side, words and ordinals; otherwise the
-/// share of words in common, lowered when both carry ordinals that differ. `None` when
-/// either name says nothing.
+/// How alike two names are, 0..1.1: 1 for the same side, words and ordinals (1.1 when spelt
+/// the same too); otherwise the share of words in common, lowered when both carry ordinals
+/// that differ. `None` when either name says nothing.
 pub fn similarity(a: &NameKey, b: &NameKey) -> Option<f64> {
     if a.is_blank() || b.is_blank() {
         return None;
     }
     if a.words == b.words && a.ordinals == b.ordinals && a.side == b.side {
-        return Some(1.0);
+        return Some(if a.spelling == b.spelling { 1.1 } else { 1.0 });
     }
     let shared = a.words.iter().filter(|w| b.words.contains(w)).count();
     let union = a.words.len() + b.words.len() - shared;
@@ -178,12 +181,13 @@ mod tests {
     #[test]
     fn spellings_agree_and_limb_words_say_front_or_hind() {
         assert_eq!(key("LeftUpLeg").words, key("Bip01_L_Thigh").words);
-        assert_eq!(key("mixamorig:LeftForeArm"), key("l_forearm"));
+        assert_eq!(key("mixamorig:LeftForeArm").words, key("l_forearm").words);
         assert_eq!(limb_word(&key("Bip01_R_HorseLink")), Some(LimbWord::Hind));
         assert_eq!(limb_word(&key("Bip01_L_Finger0")), Some(LimbWord::Front));
         assert_eq!(limb_word(&key("LeftCollar")), Some(LimbWord::Front));
         assert_eq!(limb_word(&key("Spine1")), None);
         assert_eq!(similarity(&key("LeftFoot"), &key("Bip01_L_Foot__ouF")), Some(1.0));
+        assert_eq!(similarity(&key("mixamorig:LeftFoot"), &key("LeftFoot")), Some(1.1));
         let near = similarity(&key("leg_l1_femur"), &key("leg_l3_femur")).unwrap();
         let same_leg = similarity(&key("leg_l1_femur"), &key("leg_l1_tibia")).unwrap();
         assert!(near < 1.0 && near > 0.0 && same_leg > 0.0, "{near} {same_leg}");
