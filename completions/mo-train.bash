@@ -23,7 +23,7 @@ _mo__train() {
 
     case "${cmd}" in
         mo__train)
-            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --augment --augment-variants --ema --noise-shift --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --augment --augment-variants --ema --noise-shift --loss-weighting --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -94,6 +94,10 @@ _mo__train() {
                     return 0
                     ;;
                 --noise-shift)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --loss-weighting)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;

@@ -42,6 +42,9 @@ pub struct Described {
     pub signature: Vec<Vec<usize>>,
     pub parents: Vec<Option<usize>>,
     pub leaf: Vec<bool>,
+    /// Feet and toes (`roles::feet`: AnyTop's foot words and what hangs below them, else the
+    /// lowest joints of the rest pose).
+    pub foot: Vec<bool>,
     /// Some joint has a side.
     pub has_sides: bool,
     /// Sides (and limb pairs) come from the names; otherwise from the rest pose.
@@ -130,7 +133,11 @@ pub fn describe(skeleton: &Skeleton, rest: &[DVec3], use_names: bool, roles: Rol
     let class_of_base = limb_classes(&bases, &base, limb_keys, &side, &place, n);
     let limb = (0..n).map(|j| if base[j] == usize::MAX { Limb::Centre } else { class_of_base[base[j]] }).collect();
     let leaf = children.iter().map(Vec::is_empty).collect();
-    Described { keys, side, limb, along, place, direction, signature, parents, leaf, has_sides, named_sides }
+    let mut foot = vec![false; n];
+    for f in roles::feet(skeleton).0 {
+        foot[f] = true;
+    }
+    Described { keys, side, limb, along, place, direction, signature, parents, leaf, foot, has_sides, named_sides }
 }
 
 /// Front or hind for every limb base (indexed by joint): by names when the names tell the
