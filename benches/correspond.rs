@@ -87,7 +87,8 @@ struct Score {
 /// DIFT per-joint descriptors (the `mo-dift --joints` defaults: t 2, layer 0, 4 draws, centred).
 fn dift_rows(model: &Frozen, c: &Clip) -> Option<Vec<Vec<f32>>> {
     let prepared = dift::prepare(&model.info, &c.skeleton, &c.motion, &c.name).ok()?;
-    let f = dift::extract(&model.model, &model.info.schedule(), &prepared.condition.condition(), &prepared.features, &DiftOptions::SPATIAL, &Device::Cpu).ok()?;
+    let f =
+        dift::extract(&model.model, &model.info.schedule(), &prepared.condition.condition(), &prepared.features, &DiftOptions::SPATIAL, &Device::Cpu).ok()?;
     Some(dift::centred(f.per_joint()))
 }
 
@@ -119,7 +120,9 @@ fn score_pair(model: Option<&Frozen>, a: &Clip, b: &Clip, truth: &[Option<usize>
                     "combined" => (Evidence::ALL, None),
                     _ => match &dift_sim {
                         // [target][reference] -> [source = reference][target].
-                        Some(sim) => (Evidence::ALL, Some((0..a.skeleton.len()).map(|r| (0..b.skeleton.len()).map(|t| sim[t][r]).collect()).collect::<Vec<Vec<f64>>>())),
+                        Some(sim) => {
+                            (Evidence::ALL, Some((0..a.skeleton.len()).map(|r| (0..b.skeleton.len()).map(|t| sim[t][r]).collect()).collect::<Vec<Vec<f64>>>()))
+                        }
                         None => (Evidence::ALL, None),
                     },
                 };

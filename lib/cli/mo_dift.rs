@@ -217,10 +217,17 @@ fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
     }
     let (reference, target) = (&motions[0], &motions[1]);
     let text = if args.as_binding {
-        let choices = super::correspond::bind_auto(&super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion }, &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion }, args.bind_rate)?;
+        let choices = super::correspond::bind_auto(
+            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
+            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
+            args.bind_rate,
+        )?;
         auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
     } else {
-        let scores = super::correspond::joint_scores(&super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion }, &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion })?;
+        let scores = super::correspond::joint_scores(
+            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
+            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
+        )?;
         let pairs = correspondence::assign(&scores);
         let rows: Vec<CombinedRow> = correspondence::per_target(&scores, &pairs)
             .into_iter()

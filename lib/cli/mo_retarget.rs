@@ -336,7 +336,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     // The binding.
     let (map, binding): (JointMap, Binding) = if bind == "auto" {
-        let choices = super::correspond::bind_auto(&super::correspond::Side { name: &source.name, skeleton: &source.skeleton, motion: &source.motion }, &super::correspond::Side { name: &first.name, skeleton: &first.skeleton, motion: &first.motion }, args.bind_rate)?;
+        let choices = super::correspond::bind_auto(
+            &super::correspond::Side { name: &source.name, skeleton: &source.skeleton, motion: &source.motion },
+            &super::correspond::Side { name: &first.name, skeleton: &first.skeleton, motion: &first.motion },
+            args.bind_rate,
+        )?;
         let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
         (choices.iter().map(|c| (c.source, c.target)).collect(), binding)
     } else {

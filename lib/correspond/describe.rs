@@ -119,15 +119,16 @@ pub fn describe(skeleton: &Skeleton, rest: &[DVec3], use_names: bool, roles: Rol
         }
     }
     let max_depth = depth.iter().copied().max().unwrap_or(0).max(1);
-    let along = (0..n)
-        .map(|j| {
-            if base[j] == usize::MAX {
-                depth[j] as f64 / max_depth as f64
-            } else {
-                (depth[j] - depth[base[j]]) as f64 / limb_depth[base[j]].max(1) as f64
-            }
-        })
-        .collect();
+    let along =
+        (0..n)
+            .map(|j| {
+                if base[j] == usize::MAX {
+                    depth[j] as f64 / max_depth as f64
+                } else {
+                    (depth[j] - depth[base[j]]) as f64 / limb_depth[base[j]].max(1) as f64
+                }
+            })
+            .collect();
     let bases: Vec<usize> = (0..n).filter(|&j| base[j] == j).collect();
     let limb_keys: &[NameKey] = if roles == Roles::Names { &keys } else { &[] };
     let class_of_base = limb_classes(&bases, &base, limb_keys, &side, &place, n);

@@ -120,7 +120,8 @@ pub fn scores(source: &Body, target: &Body, evidence: Evidence, extra: Option<&[
     let roles = if named(source) && named(target) { Roles::Names } else { Roles::Geometry };
     let a = describe(source.skeleton, source.rest, evidence.names, roles);
     let b = describe(target.skeleton, target.rest, evidence.names, roles);
-    let score = (0..ns).map(|s| (0..nt).map(|t| pair_score(&a, s, &b, t, evidence).map(|v| v + extra.map_or(0.0, |x| EXTRA_WEIGHT * x[s][t]))).collect()).collect();
+    let score =
+        (0..ns).map(|s| (0..nt).map(|t| pair_score(&a, s, &b, t, evidence).map(|v| v + extra.map_or(0.0, |x| EXTRA_WEIGHT * x[s][t]))).collect()).collect();
     Ok(Scores { source: a, target: b, score })
 }
 
@@ -225,7 +226,8 @@ fn hungarian(score: &[Vec<Option<f64>>], nt: usize) -> Vec<Option<usize>> {
 
 /// Highest score first, each joint once (ties by index).
 fn greedy(score: &[Vec<Option<f64>>], nt: usize) -> Vec<Option<usize>> {
-    let mut all: Vec<(f64, usize, usize)> = score.iter().enumerate().flat_map(|(s, r)| r.iter().enumerate().filter_map(move |(t, v)| v.map(|v| (v, s, t)))).collect();
+    let mut all: Vec<(f64, usize, usize)> =
+        score.iter().enumerate().flat_map(|(s, r)| r.iter().enumerate().filter_map(move |(t, v)| v.map(|v| (v, s, t)))).collect();
     all.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
     let mut out = vec![None; score.len()];
     let mut used = vec![false; nt];

@@ -36,15 +36,15 @@ impl NameKey {
 }
 
 /// Two-word spellings of one part, and single-word synonyms, mapped to one word.
-const PHRASES: &[(&str, &str, &str)] =
-    &[("up", "leg", "thigh"), ("up", "arm", "upperarm"), ("upper", "arm", "upperarm"), ("fore", "arm", "forearm"), ("horse", "link", "horselink"), ("toe", "base", "toe")];
-const SYNONYMS: &[(&str, &str)] = &[
-    ("upleg", "thigh"),
-    ("uparm", "upperarm"),
-    ("toes", "toe"),
-    ("fingers", "finger"),
-    ("collar", "clavicle"),
+const PHRASES: &[(&str, &str, &str)] = &[
+    ("up", "leg", "thigh"),
+    ("up", "arm", "upperarm"),
+    ("upper", "arm", "upperarm"),
+    ("fore", "arm", "forearm"),
+    ("horse", "link", "horselink"),
+    ("toe", "base", "toe"),
 ];
+const SYNONYMS: &[(&str, &str)] = &[("upleg", "thigh"), ("uparm", "upperarm"), ("toes", "toe"), ("fingers", "finger"), ("collar", "clavicle")];
 
 /// Words of the front limbs (arms, wings) and of the hind limbs (legs).
 const FRONT_WORDS: &[&str] =

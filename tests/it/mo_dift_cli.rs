@@ -66,11 +66,22 @@ fn as_binding_is_what_bind_auto_binds_and_dift_only_stays_available() {
         ok(&from_dift, "mo-dift --as-binding");
         let from_retarget = run("mo-retarget", &[s(&a), s(&b), "--bind", "auto", "--emit-binding"], None);
         ok(&from_retarget, "mo-retarget --emit-binding");
-        let (x, y) = (Binding::from_json(&String::from_utf8_lossy(&from_dift.stdout), "d").unwrap(), Binding::from_json(&String::from_utf8_lossy(&from_retarget.stdout), "r").unwrap());
+        let (x, y) = (
+            Binding::from_json(&String::from_utf8_lossy(&from_dift.stdout), "d").unwrap(),
+            Binding::from_json(&String::from_utf8_lossy(&from_retarget.stdout), "r").unwrap(),
+        );
         assert_eq!(x.mapping, y.mapping, "{}: one engine, one answer", a.display());
         // Every pair keeps its side; more than the paper's 6.1% rate is bound.
         for p in &x.mapping {
-            let side = |n: &str| if n.contains("_l") || n.contains("_L") || n.contains("Left") { 'L' } else if n.contains("_r") || n.contains("_R") || n.contains("Right") { 'R' } else { 'C' };
+            let side = |n: &str| {
+                if n.contains("_l") || n.contains("_L") || n.contains("Left") {
+                    'L'
+                } else if n.contains("_r") || n.contains("_R") || n.contains("Right") {
+                    'R'
+                } else {
+                    'C'
+                }
+            };
             assert!(!matches!((side(&p.source), side(&p.target)), ('L', 'R') | ('R', 'L')), "{} -> {}", p.source, p.target);
         }
         assert!(x.mapping.len() >= 4, "{} pairs", x.mapping.len());
