@@ -44,8 +44,7 @@ const PHRASES: &[(&str, &str, &str)] = &[
     ("horse", "link", "horselink"),
     ("toe", "base", "toe"),
 ];
-const SYNONYMS: &[(&str, &str)] =
-    &[("upleg", "thigh"), ("uparm", "upperarm"), ("toes", "toe"), ("fingers", "finger"), ("collar", "clavicle"), ("shin", "calf")];
+const SYNONYMS: &[(&str, &str)] = &[("upleg", "thigh"), ("uparm", "upperarm"), ("toes", "toe"), ("fingers", "finger"), ("collar", "clavicle")];
 
 /// Words of the front limbs (arms, wings) and of the hind limbs (legs).
 const FRONT_WORDS: &[&str] =
