@@ -109,14 +109,7 @@ pub fn to_binding(choices: &[Choice], source: &Skeleton, source_name: &str, targ
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth;
-    use glam::DVec3;
-
-    fn body_of(name: &str) -> (Skeleton, Vec<DVec3>) {
-        let (skeleton, _) = synth::creature(name, 1).unwrap();
-        let rest = skeleton.rest_positions();
-        (skeleton, rest)
-    }
+    use crate::correspond::tests::body_of;
 
     #[test]
     fn a_skeleton_binds_to_itself_joint_for_joint() {

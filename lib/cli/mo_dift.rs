@@ -229,37 +229,18 @@ fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
             &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
         )?;
         let pairs = correspondence::assign(&scores);
-        let rows: Vec<CombinedRow> = correspondence::per_target(&scores, &pairs)
+        let rows: Vec<JointRow> = correspondence::per_target(&scores, &pairs)
             .into_iter()
             .filter_map(|(_, found)| found)
-            .map(|(p, one_to_one)| CombinedRow {
-                target: target.skeleton.joints[p.target].name.clone(),
-                target_index: p.target,
-                reference: reference.skeleton.joints[p.source].name.clone(),
-                reference_index: p.source,
-                score: round(p.score),
-                margin: round(p.margin),
-                confidence: round(p.confidence),
-                one_to_one,
+            .map(|(p, one_to_one)| {
+                let m = Match { target: p.target, reference: p.source, score: p.score, margin: p.margin };
+                JointRow { confidence: Some(round(p.confidence)), one_to_one: Some(one_to_one), ..joint_row(&m, reference, target) }
             })
             .collect();
         let header = serde_json::json!({ "reference": reference.name, "target": target.name, "features": "combined" });
         pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
     };
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
-}
-
-/// One target joint's answer from the engine.
-#[derive(serde::Serialize)]
-struct CombinedRow {
-    target: String,
-    target_index: usize,
-    reference: String,
-    reference_index: usize,
-    score: f64,
-    margin: f64,
-    confidence: f64,
-    one_to_one: bool,
 }
 
 /// One skeleton in two files: the same joints (names and parents) in the same order; bone
@@ -284,6 +265,11 @@ struct JointRow {
     reference_index: usize,
     score: f64,
     margin: f64,
+    /// The engine's confidence and whether the pair is one to one (absent with dift-only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    confidence: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    one_to_one: Option<bool>,
 }
 
 fn joint_row(m: &Match, reference: &Loaded, target: &Loaded) -> JointRow {
@@ -294,6 +280,8 @@ fn joint_row(m: &Match, reference: &Loaded, target: &Loaded) -> JointRow {
         reference_index: m.reference,
         score: round(m.score),
         margin: round(m.margin),
+        confidence: None,
+        one_to_one: None,
     }
 }
 

@@ -285,11 +285,12 @@ pub fn bindable(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::synth;
 
-    fn body_of(name: &str) -> (Skeleton, Vec<DVec3>) {
+    /// A zoo creature and its rest positions (also for `binding::auto`'s tests).
+    pub(crate) fn body_of(name: &str) -> (Skeleton, Vec<DVec3>) {
         let (skeleton, _) = synth::creature(name, 1).unwrap();
         let rest = skeleton.rest_positions();
         (skeleton, rest)

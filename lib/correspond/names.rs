@@ -11,7 +11,7 @@
 //! It also says which pair of limbs a word belongs to: arm, hand, finger, clavicle, wing are
 //! front-limb words; thigh, calf, foot, toe, horselink are hind-limb words.
 
-use crate::skeleton::names::{split_words, Side, GLUED_SIDE_WORDS, JAPANESE, RIG_PREFIXES};
+use crate::skeleton::names::{classify, drop_rig_prefixes, split_words, Side, Word};
 
 /// What a joint's name says, for matching.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -62,51 +62,25 @@ pub enum LimbWord {
 pub fn key(raw: &str) -> NameKey {
     let mut words = split_words(raw);
     let spelling = words.join("_").to_ascii_lowercase();
-    while words.len() > 1 {
-        let w = words[0].to_ascii_lowercase();
-        if RIG_PREFIXES.contains(&w.as_str()) || w.chars().all(|c| c.is_ascii_digit()) {
-            words.remove(0);
-        } else {
-            break;
-        }
-    }
+    drop_rig_prefixes(&mut words);
     let mut out = NameKey { spelling, ..NameKey::default() };
     let mut body: Vec<String> = Vec::new();
     for w in &words {
         let lower = w.to_ascii_lowercase();
-        if lower.chars().all(|c| c.is_ascii_digit()) {
+        match classify(&lower) {
             // Too many digits to be an ordinal: a number is still a number, saturated.
-            out.ordinals.push(lower.parse().unwrap_or(u64::MAX));
-            continue;
-        }
-        match lower.as_str() {
-            "l" | "left" => {
-                out.side.get_or_insert(Side::Left);
-                continue;
+            Word::Number => out.ordinals.push(lower.parse().unwrap_or(u64::MAX)),
+            Word::Side(s) => {
+                out.side.get_or_insert(s);
             }
-            "r" | "right" => {
-                out.side.get_or_insert(Side::Right);
-                continue;
+            Word::Known(en) => body.push(en.to_ascii_lowercase()),
+            Word::Glued(s, part) => {
+                out.side.get_or_insert(s);
+                body.push(part.to_string());
             }
-            _ => {}
+            Word::Plain if lower.chars().count() == 1 => {}
+            Word::Plain => body.push(lower),
         }
-        if let Some((_, en)) = JAPANESE.iter().find(|(jp, _)| *jp == lower) {
-            body.push(en.to_ascii_lowercase());
-            continue;
-        }
-        if lower == "tai" {
-            body.push("tail".into());
-            continue;
-        }
-        if lower.len() > 2 && (lower.starts_with('l') || lower.starts_with('r')) && GLUED_SIDE_WORDS.contains(&&lower[1..]) {
-            out.side.get_or_insert(if lower.starts_with('l') { Side::Left } else { Side::Right });
-            body.push(lower[1..].to_string());
-            continue;
-        }
-        if lower.chars().count() == 1 {
-            continue;
-        }
-        body.push(lower);
     }
     // Phrases first (`up leg`), then single-word synonyms.
     let mut i = 0;
