@@ -17,7 +17,8 @@
 //!
 //! The corpus rows need ../shared/data (skipped with a message when absent). Clips are cut to
 //! their first 120 frames. "combined + DIFT" adds DIFT cosine as extra evidence
-//! (`correspond::EXTRA_WEIGHT`), a column to decide whether the tools should.
+//! (`correspond::EXTRA_WEIGHT`), a column to decide whether the tools should. CORRESPOND_DEBUG=1
+//! prints every wrong answer on stderr.
 mod common;
 
 use candle_core::Device;
