@@ -1,6 +1,8 @@
 complete -c mo-dift -l align -d 'With --frames: how frames are matched' -r -f -a "monotonic\t'In time order (dynamic time warping): the answers never go back'
 nearest\t'Each target frame on its own: the most similar reference frame (the paper\'s rule)'"
-complete -c mo-dift -l bind-rate -d 'With --as-binding: binding rate 2 x pairs / (REF joints + TGT joints)' -r
+complete -c mo-dift -l bind-rate -d 'With --as-binding: at most this binding rate, 2 x pairs / (REF joints + TGT joints) [default: combined, every confident pair; dift-only, 0.061]' -r
+complete -c mo-dift -l features -d 'With --joints: the evidence joints are matched by' -r -f -a "combined\t'The correspondence engine (names, sides, limbs, topology, rest pose); no model runs'
+dift-only\t'DIFT features alone (AnyTop §4.1), for research'"
 complete -c mo-dift -l t -d 'Diffusion step the motion is noised to (0..T-1) [default: joints 2, otherwise 3]' -r
 complete -c mo-dift -l layer -d 'Layer whose activations are read (0-based) [default: joints 0, otherwise 1]' -r
 complete -c mo-dift -l draws -d 'Noise draws averaged' -r

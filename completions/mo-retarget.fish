@@ -3,7 +3,7 @@ complete -c mo-retarget -l method -d 'How to transfer: m2m (Motion2Motion, from 
 latent\t''"
 complete -c mo-retarget -l to -d 'latent: the target skeleton, a BVH or a skeleton document (instead of TARGETS)' -r -F
 complete -c mo-retarget -l model -d 'latent: the model directory from \'mo-train --arch sata\' [default: the built-in one]' -r -F
-complete -c mo-retarget -l bind-rate -d 'Binding rate of --bind auto: 2 x pairs / (source joints + target joints)' -r
+complete -c mo-retarget -l bind-rate -d 'Limit of --bind auto: at most this binding rate, 2 x pairs / (source joints + target joints) (the paper: 0.061) [default: every confident pair]' -r
 complete -c mo-retarget -s n -l samples -d 'Number of diverse samples' -r
 complete -c mo-retarget -l frames -d 'Output length in frames [default: the source\'s, after resampling]' -r
 complete -c mo-retarget -l seconds -d 'Output length in seconds' -r

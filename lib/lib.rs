@@ -46,6 +46,7 @@ pub mod binding;
 pub mod budget;
 pub mod bvh;
 pub mod cli;
+pub mod correspond;
 pub mod diffusion;
 pub mod dift;
 pub mod document;

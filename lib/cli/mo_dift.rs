@@ -4,6 +4,7 @@ use crate::binding::auto;
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions, Loaded};
 use crate::cli::CommonOpts;
+use crate::correspond as correspondence;
 use crate::diffusion::checkpoint::{self, Frozen};
 use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, monotonic_matches, Match};
 use crate::dift::{self, DiftFeatures, DiftOptions};
@@ -29,13 +30,19 @@ EXAMPLES:
 ///
 /// With one INPUT: the features as NPY float32 [frames + 1, joints, width] (stdout or -o).
 ///
-/// --joints REF TGT: joint correspondence. Features averaged over frames, each skeleton's mean
-/// joint descriptor subtracted (what all its joints share would otherwise dominate), cosine,
-/// the best REF joint for every TGT joint, as JSON with scores (cosine) and margins (best minus
-/// second best). --as-binding writes instead a sparse binding REF -> TGT that `mo-retarget
-/// REF.bvh TGT.bvh --bind bind.json` reads: mutual best pairs of joints that move a bone (not
-/// the root, not leaves), most similar first, as many as --bind-rate asks for
-/// (Motion2Motion's rate, as --bind auto).
+/// --joints REF TGT: joint correspondence, a REF joint for every TGT joint, as JSON. By default
+/// (--features combined) the correspondence engine that `mo-retarget --bind auto` uses, and no
+/// model runs: joint names with their sides and ordinals, front and hind limbs, topology and
+/// rest pose, never left with right nor front limb with hind limb, assigned one to one
+/// (one_to_one false: a TGT joint left over, given its best allowed REF joint); score is the
+/// combined evidence, margin how far it beats the best alternative, confidence 0..1 from it.
+/// --features dift-only: the paper's DIFT matching (features averaged over frames, each
+/// skeleton's mean joint descriptor subtracted, cosine, the best REF joint for every TGT
+/// joint; score cosine, margin best minus second best). --as-binding writes instead a binding
+/// REF -> TGT that `mo-retarget REF.bvh TGT.bvh --bind bind.json` reads: combined, exactly
+/// what --bind auto binds (every confident pair of joints that move a bone, same side, same
+/// limb pair; at most --bind-rate); dift-only, mutual best pairs of joints that move a bone,
+/// most similar first, as many as --bind-rate asks for (default 0.061, the paper's rate).
 ///
 /// --frames REF TGT: frame correspondence, a REF frame for every TGT frame, as JSON. Frame
 /// descriptors are the joints' features side by side when REF and TGT share a skeleton (same
@@ -71,9 +78,13 @@ pub struct Args {
     /// With --joints: write a sparse binding REF -> TGT for mo-retarget --bind.
     #[arg(long, requires = "joints")]
     pub as_binding: bool,
-    /// With --as-binding: binding rate 2 x pairs / (REF joints + TGT joints).
-    #[arg(long, value_name = "R", default_value_t = 0.061, requires = "as_binding")]
-    pub bind_rate: f64,
+    /// With --as-binding: at most this binding rate, 2 x pairs / (REF joints + TGT joints)
+    /// [default: combined, every confident pair; dift-only, 0.061].
+    #[arg(long, value_name = "R", requires = "as_binding")]
+    pub bind_rate: Option<f64>,
+    /// With --joints: the evidence joints are matched by.
+    #[arg(long, value_enum, value_name = "WHICH", default_value_t = Features::Combined, requires = "joints")]
+    pub features: Features,
     /// Diffusion step the motion is noised to (0..T-1) [default: joints 2, otherwise 3].
     #[arg(long, value_name = "T", value_parser = bounds::count(0, bounds::MAX_DIFFUSION_T))]
     pub t: Option<usize>,
@@ -93,6 +104,15 @@ pub struct Args {
     pub common: CommonOpts,
 }
 
+/// What `--joints` matches joints by.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Features {
+    /// The correspondence engine (names, sides, limbs, topology, rest pose); no model runs.
+    Combined,
+    /// DIFT features alone (AnyTop §4.1), for research.
+    DiftOnly,
+}
+
 /// How `--frames` matches frames.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Align {
@@ -110,6 +130,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (true, 2) | (false, 1) => {}
         (true, n) => bail!("--joints and --frames compare two motions, REF and TGT; {n} given"),
         (false, n) => bail!("features are written for one motion; {n} given (use --joints or --frames to compare two)"),
+    }
+    if let Some(rate) = args.bind_rate {
+        if !(rate.is_finite() && rate > 0.0 && rate <= 1.0) {
+            bail!("--bind-rate must be within (0, 1], found {rate}");
+        }
+    }
+    if args.joints && args.features == Features::Combined {
+        return combined_joints(args, &inputs);
     }
     let device = Device::Cpu;
     let model = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
@@ -145,10 +173,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let text = if args.joints {
             let sim = cosine_matrix(&dift::centred(features[1].per_joint()), &dift::centred(features[0].per_joint()));
             if args.as_binding {
-                if !(args.bind_rate.is_finite() && args.bind_rate > 0.0 && args.bind_rate <= 1.0) {
-                    bail!("--bind-rate must be within (0, 1], found {}", args.bind_rate);
-                }
-                let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, args.bind_rate, auto::AutoOptions::default().min_pairs);
+                let rate = args.bind_rate.unwrap_or(DIFT_BIND_RATE);
+                let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, rate, auto::AutoOptions::default().min_pairs);
                 if choices.is_empty() {
                     bail!(
                         "{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind",
@@ -180,6 +206,43 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
 
+/// The paper's binding rate, what `--features dift-only --as-binding` binds by default.
+const DIFT_BIND_RATE: f64 = 0.061;
+
+/// `--joints` with the correspondence engine: no model, the same scores `--bind auto` uses.
+fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
+    let motions = load_motions(inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
+    if motions.len() != inputs.len() {
+        bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
+    }
+    let (reference, target) = (&motions[0], &motions[1]);
+    let text = if args.as_binding {
+        let choices = super::correspond::bind_auto(
+            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
+            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
+            args.bind_rate,
+        )?;
+        auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
+    } else {
+        let scores = super::correspond::joint_scores(
+            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
+            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
+        )?;
+        let pairs = correspondence::assign(&scores);
+        let rows: Vec<JointRow> = correspondence::per_target(&scores, &pairs)
+            .into_iter()
+            .filter_map(|(_, found)| found)
+            .map(|(p, one_to_one)| {
+                let m = Match { target: p.target, reference: p.source, score: p.score, margin: p.margin };
+                JointRow { confidence: Some(round(p.confidence)), one_to_one: Some(one_to_one), ..joint_row(&m, reference, target) }
+            })
+            .collect();
+        let header = serde_json::json!({ "reference": reference.name, "target": target.name, "features": "combined" });
+        pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
+    };
+    Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
+}
+
 /// One skeleton in two files: the same joints (names and parents) in the same order; bone
 /// lengths may differ.
 fn same_skeleton(a: &crate::skeleton::Skeleton, b: &crate::skeleton::Skeleton) -> bool {
@@ -202,6 +265,11 @@ struct JointRow {
     reference_index: usize,
     score: f64,
     margin: f64,
+    /// The engine's confidence and whether the pair is one to one (absent with dift-only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    confidence: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    one_to_one: Option<bool>,
 }
 
 fn joint_row(m: &Match, reference: &Loaded, target: &Loaded) -> JointRow {
@@ -212,6 +280,8 @@ fn joint_row(m: &Match, reference: &Loaded, target: &Loaded) -> JointRow {
         reference_index: m.reference,
         score: round(m.score),
         margin: round(m.margin),
+        confidence: None,
+        one_to_one: None,
     }
 }
 

@@ -3,15 +3,13 @@
 //! calls `retarget::retarget_samples`, and writes BVH (or NPY) on the target skeleton. All
 //! outputs are built in memory first, so a failure never leaves some files written.
 
-use crate::binding::auto::{self, AutoOptions, Body};
+use crate::binding::auto;
 use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
 use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips, BvhClip, MotionFormat};
 use crate::cli::CommonOpts;
-use crate::document::AnyTopSection;
 use crate::io::{self, npy};
 use crate::motion::Motion;
-use crate::repr::anytop::AnyTopOptions;
 use crate::repr::m2m;
 use crate::retarget::{self, BoundRotation, Repr, RootMotion, Settings};
 use anyhow::{bail, Context};
@@ -37,10 +35,12 @@ EXAMPLES:
 ///
 /// Binding: --bind FILE reads pairs source joint -> target joint (our JSON or the reference's
 /// {\"mapping\": [{\"source\", \"target\"}]}); names match exactly, by case, without namespace
-/// or by normalised name, never by substring. --bind auto computes a sparse binding (chain
-/// bone directions as in the paper's appendix A, plus body place, sides, feet and names) at
-/// --bind-rate (the paper's 6.1%); --emit-binding prints it as JSON to inspect, edit and
-/// reuse instead of retargeting.
+/// or by normalised name, never by substring. --bind auto binds every confident pair of the
+/// joint correspondence that `mo-dift --joints` prints (names with their sides and ordinals,
+/// front and hind limbs, topology and rest pose, one to one): the same side, the same limb
+/// pair, joints that move a bone; --bind-rate R keeps at most that rate (the paper's 0.061
+/// gives its sparse binding); --emit-binding prints it as JSON to inspect, edit and reuse
+/// instead of retargeting.
 ///
 /// Frame rates: the source is resampled to the examples' rate when they differ (said on
 /// stderr). Output length: the source's, or --frames / --seconds. --key-frames makes the
@@ -80,9 +80,10 @@ pub struct Args {
     /// latent: the model directory from 'mo-train --arch sata' [default: the built-in one].
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
-    /// Binding rate of --bind auto: 2 x pairs / (source joints + target joints).
-    #[arg(long, value_name = "R", default_value_t = 0.061, value_parser = bounds::positive(1.0))]
-    pub bind_rate: f64,
+    /// Limit of --bind auto: at most this binding rate, 2 x pairs / (source joints + target
+    /// joints) (the paper: 0.061) [default: every confident pair].
+    #[arg(long, value_name = "R", value_parser = bounds::positive(1.0))]
+    pub bind_rate: Option<f64>,
     /// Print the binding (JSON) and stop.
     #[arg(long)]
     pub emit_binding: bool,
@@ -244,13 +245,6 @@ fn read_clip(path: &Path) -> anyhow::Result<Clip> {
     read_bvh_clip(path, "mo-retarget")
 }
 
-/// The AnyTop rig's natural rest pose: faces +z, so two creatures compare in one frame.
-fn canonical_rest(c: &Clip) -> anyhow::Result<Vec<glam::DVec3>> {
-    let section = AnyTopSection::new(&c.skeleton, &c.motion.first_frames(2), &AnyTopOptions::default())
-        .with_context(|| format!("{}: cannot find its rest pose and facing", c.name))?;
-    Ok(section.rig.rest_positions(&c.skeleton))
-}
-
 fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Settings> {
     let mut s = Settings { seed: args.common.seed, copy_bound: args.copy_bound, ..Settings::default() };
     if let Some(p) = args.patch {
@@ -358,9 +352,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     // The binding.
     let (map, binding): (JointMap, Binding) = if bind == "auto" {
-        let (ra, rb) = (canonical_rest(&source)?, canonical_rest(first)?);
-        let opts = AutoOptions { rate: args.bind_rate, ..AutoOptions::default() };
-        let choices = auto::auto_bind(&Body { skeleton: &source.skeleton, rest: &ra }, &Body { skeleton: &first.skeleton, rest: &rb }, &opts)?;
+        let choices = super::correspond::bind_auto(
+            &super::correspond::Side { name: &source.name, skeleton: &source.skeleton, motion: &source.motion },
+            &super::correspond::Side { name: &first.name, skeleton: &first.skeleton, motion: &first.motion },
+            args.bind_rate,
+        )?;
         let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
         (choices.iter().map(|c| (c.source, c.target)).collect(), binding)
     } else {

@@ -98,10 +98,8 @@ pub fn split_words(raw: &str) -> Vec<String> {
     words
 }
 
-/// The normalised, readable name of a raw joint name.
-pub fn normalise(raw: &str) -> String {
-    let mut words = split_words(raw);
-    // Rule 3: leading rig prefixes (also `Bip01` split as `Bip` + `01`).
+/// Drop leading rig prefixes (rule 3; also `Bip01` split as `Bip` + `01`), keeping one word.
+pub(crate) fn drop_rig_prefixes(words: &mut Vec<String>) {
     while words.len() > 1 {
         let w = words[0].to_ascii_lowercase();
         if RIG_PREFIXES.contains(&w.as_str()) || w.chars().all(|c| c.is_ascii_digit()) {
@@ -110,48 +108,68 @@ pub fn normalise(raw: &str) -> String {
             break;
         }
     }
-    let mut side: Option<&str> = None;
+}
+
+/// What one lower-case word of a name is (rule 4), shared by `normalise` and the
+/// correspondence key (`correspond::names`), which keep different parts of it.
+pub(crate) enum Word<'a> {
+    Number,
+    Side(Side),
+    /// A translated word (`momo` -> Thigh, `tai` -> Tail).
+    Known(&'static str),
+    /// A side letter glued to a body word (`lhand`): the side and the body word.
+    Glued(Side, &'a str),
+    Plain,
+}
+
+pub(crate) fn classify(lower: &str) -> Word<'_> {
+    if lower.chars().all(|c| c.is_ascii_digit()) {
+        return Word::Number;
+    }
+    match lower {
+        "l" | "left" => return Word::Side(Side::Left),
+        "r" | "right" => return Word::Side(Side::Right),
+        _ => {}
+    }
+    if let Some((_, en)) = JAPANESE.iter().find(|(jp, _)| *jp == lower) {
+        return Word::Known(en);
+    }
+    if lower == "tai" {
+        return Word::Known("Tail");
+    }
+    if lower.len() > 2 && (lower.starts_with('l') || lower.starts_with('r')) && GLUED_SIDE_WORDS.contains(&&lower[1..]) {
+        return Word::Glued(if lower.starts_with('l') { Side::Left } else { Side::Right }, &lower[1..]);
+    }
+    Word::Plain
+}
+
+/// The normalised, readable name of a raw joint name.
+pub fn normalise(raw: &str) -> String {
+    let mut words = split_words(raw);
+    drop_rig_prefixes(&mut words);
+    let mut side: Option<Side> = None;
     let mut out: Vec<String> = Vec::new();
     for w in &words {
         let lower = w.to_ascii_lowercase();
-        if lower.chars().all(|c| c.is_ascii_digit()) {
-            continue;
-        }
-        match lower.as_str() {
-            "l" | "left" => {
-                side.get_or_insert("Left");
-                continue;
+        match classify(&lower) {
+            Word::Number => {}
+            Word::Side(s) => {
+                side.get_or_insert(s);
             }
-            "r" | "right" => {
-                side.get_or_insert("Right");
-                continue;
+            Word::Known(en) => out.push(en.to_string()),
+            Word::Glued(s, body) => {
+                side.get_or_insert(s);
+                out.push(capitalise(body));
             }
-            _ => {}
+            Word::Plain if w.chars().count() == 1 => {}
+            Word::Plain => out.push(capitalise(w)),
         }
-        if let Some((_, en)) = JAPANESE.iter().find(|(jp, _)| *jp == lower) {
-            out.push(en.to_string());
-            continue;
-        }
-        if lower == "tai" {
-            out.push("Tail".into());
-            continue;
-        }
-        // `lhand` / `rfoot`: a side letter glued to a known body word.
-        if lower.len() > 2 && (lower.starts_with('l') || lower.starts_with('r')) && GLUED_SIDE_WORDS.contains(&&lower[1..]) {
-            side.get_or_insert(if lower.starts_with('l') { "Left" } else { "Right" });
-            out.push(capitalise(&lower[1..]));
-            continue;
-        }
-        if w.chars().count() == 1 {
-            continue;
-        }
-        out.push(capitalise(w));
     }
     if out.is_empty() && side.is_none() {
         // Nothing survived (e.g. `Bip01`): keep the raw name minus namespace so it stays unique-ish.
         return split_words(raw).join(" ");
     }
-    let mut parts: Vec<String> = side.map(|s| s.to_string()).into_iter().collect();
+    let mut parts: Vec<String> = side.map(|s| if s == Side::Left { "Left" } else { "Right" }.to_string()).into_iter().collect();
     parts.extend(out);
     parts.join(" ")
 }

@@ -5,6 +5,7 @@
 use crate::common;
 
 use menagerie::binding::auto::{auto_bind, AutoOptions, Body, Choice};
+use menagerie::correspond::Evidence;
 use menagerie::document::AnyTopSection;
 use menagerie::repr::anytop::AnyTopOptions;
 use menagerie::skeleton::Skeleton;
@@ -42,18 +43,18 @@ fn at_least_90_percent(what: &str, good: usize, total: usize) {
 fn known_correspondences_are_found() {
     let Some(data) = common::shared_data("known_correspondences_are_found") else { return };
     let bvh = data.join("bvh");
-    for rate in [0.061, 0.2] {
+    for rate in [Some(0.061), Some(0.2), None] {
         let opts = AutoOptions { rate, ..AutoOptions::default() };
         // CMU and Xia: the same 31-joint tree in the same file order.
         let (sa, sb, pairs) = bind(&bvh.join("cmu_bvh11/131_01.bvh"), &bvh.join("xia_dme/neutral_01_000.bvh"), &opts);
         assert_eq!(sa.parents(), sb.parents());
-        let good = report(&format!("CMU -> Xia at {rate}"), &sa, &sb, &pairs, |c| c.source == c.target);
+        let good = report(&format!("CMU -> Xia at {rate:?}"), &sa, &sb, &pairs, |c| c.source == c.target);
         at_least_90_percent("CMU -> Xia", good, pairs.len());
         // Joe and Malcolm: Mixamo names under different namespaces; Malcolm has eyes too.
         let (sa, sb, pairs) = bind(&bvh.join("ganimator/Joe/Walk-In-Circle.bvh"), &bvh.join("ganimator/Malcolm/Gangnam-Style.bvh"), &opts);
         // Same name once the namespace is gone (normalised names drop digits: Middle1 vs Middle2).
         let bare = |n: &str| n.rsplit(':').next().unwrap_or(n).to_string();
-        let good = report(&format!("Joe -> Malcolm at {rate}"), &sa, &sb, &pairs, |c| bare(&sa.joints[c.source].name) == bare(&sb.joints[c.target].name));
+        let good = report(&format!("Joe -> Malcolm at {rate:?}"), &sa, &sb, &pairs, |c| bare(&sa.joints[c.source].name) == bare(&sb.joints[c.target].name));
         at_least_90_percent("Joe -> Malcolm", good, pairs.len());
     }
 }
@@ -104,7 +105,8 @@ fn skel_aug_variants_bind_back_to_their_original() {
             let section = AnyTopSection::new(&plan.skeleton, &variant.first_frames(2), &AnyTopOptions::default()).unwrap();
             let rb = section.rig.rest_positions(&plan.skeleton);
             for (names, total) in [(true, &mut with_names), (false, &mut geometry)] {
-                let opts = AutoOptions { rate: 0.15, names, ..AutoOptions::default() };
+                let evidence = if names { Evidence::ALL } else { Evidence::GEOMETRY };
+                let opts = AutoOptions { evidence, ..AutoOptions::default() };
                 let pairs = auto_bind(&Body { skeleton: &sa, rest: &ra }, &Body { skeleton: &plan.skeleton, rest: &rb }, &opts).unwrap();
                 let what = format!("{file} variant {seed}{}", if names { "" } else { ", geometry only" });
                 total.0 += report(&what, &sa, &plan.skeleton, &pairs, |c| sa.joints[c.source].name == plan.skeleton.joints[c.target].name);

@@ -58,6 +58,49 @@ fn joints_of_a_skel_aug_variant_find_their_originals_and_bind() {
 }
 
 #[test]
+fn as_binding_is_what_bind_auto_binds_and_dift_only_stays_available() {
+    let dir = tempdir("engine");
+    for (a, b) in [("biped.bvh", "quadruped.bvh"), ("spider.bvh", "centipede.bvh"), ("quadruped.bvh", "dragon.bvh")] {
+        let (a, b) = (example(a), example(b));
+        let from_dift = run("mo-dift", &["--joints", s(&a), s(&b), "--as-binding"], None);
+        ok(&from_dift, "mo-dift --as-binding");
+        let from_retarget = run("mo-retarget", &[s(&a), s(&b), "--bind", "auto", "--emit-binding"], None);
+        ok(&from_retarget, "mo-retarget --emit-binding");
+        let (x, y) = (
+            Binding::from_json(&String::from_utf8_lossy(&from_dift.stdout), "d").unwrap(),
+            Binding::from_json(&String::from_utf8_lossy(&from_retarget.stdout), "r").unwrap(),
+        );
+        assert_eq!(x.mapping, y.mapping, "{}: one engine, one answer", a.display());
+        // Every pair keeps its side; more than the paper's 6.1% rate is bound.
+        for p in &x.mapping {
+            let side = |n: &str| {
+                if n.contains("_l") || n.contains("_L") || n.contains("Left") {
+                    'L'
+                } else if n.contains("_r") || n.contains("_R") || n.contains("Right") {
+                    'R'
+                } else {
+                    'C'
+                }
+            };
+            assert!(!matches!((side(&p.source), side(&p.target)), ('L', 'R') | ('R', 'L')), "{} -> {}", p.source, p.target);
+        }
+        assert!(x.mapping.len() >= 4, "{} pairs", x.mapping.len());
+        let limited = run("mo-retarget", &[s(&a), s(&b), "--bind", "auto", "--bind-rate", "0.061", "--emit-binding"], None);
+        let limited = Binding::from_json(&String::from_utf8_lossy(&limited.stdout), "l").unwrap();
+        assert!(limited.mapping.len() <= x.mapping.len() && limited.mapping[..] == x.mapping[..limited.mapping.len()]);
+    }
+    // The spider's legs keep their numbers: leg 3 goes to leg 3 of a copy.
+    let spider = example("spider.bvh");
+    let out = run("mo-dift", &["--joints", s(&spider), s(&spider)], None);
+    ok(&out, "spider joints");
+    let doc = json(&out.stdout);
+    let rows = doc["matches"].as_array().unwrap();
+    assert!(rows.iter().all(|m| m["target"] == m["reference"] && m["one_to_one"] == true));
+    let dift = run("mo-dift", &["--joints", s(&spider), s(&spider), "--features", "dift-only", "--draws", "1", "-o", s(&dir.join("d.json"))], None);
+    ok(&dift, "dift-only");
+}
+
+#[test]
 fn frames_of_a_clip_against_itself_match_one_to_one() {
     let quad = example("quadruped.bvh");
     let out = run("mo-dift", &["--frames", s(&quad), s(&quad), "--draws", "2"], None);

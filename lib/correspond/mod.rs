@@ -1,0 +1,342 @@
+//! One joint-correspondence engine for everything that matches joints across two skeletons:
+//! `mo-dift --joints` (and its `--as-binding`) and `mo-retarget --bind auto` (issue 24).
+//!
+//! Each source of evidence alone makes mistakes a person reading the rigs would not: DIFT
+//! features swap left and right on real rigs, bone directions confuse arms with legs, names
+//! lie sometimes (CMU's `LeftShoulder` is Xia's `LeftArm`). So every pair of joints gets one
+//! score that adds up:
+//!
+//! * names (`names`): the same side, words and ordinals score 1, shared words less;
+//! * topology: the same place in two identical trees (subtree sizes from the root down) also
+//!   scores 1, so where two rigs share a tree but not their names, the tree wins;
+//! * rest-pose geometry: where the joint sits relative to the root (facing +z, divided by the
+//!   skeleton's size), the directions of its bone chain, its position along its limb;
+//! * optional extra similarity (DIFT features), with a small weight.
+//!
+//! and two hard rules: never left with right (when both skeletons have sides), never a front
+//! limb with a hind limb (when both limbs' pairs are known). Joints are then assigned one to
+//! one, maximising the total score (the Hungarian method, `pathfinding::kuhn_munkres`); a joint
+//! may stay unmatched when every partner scores below `UNMATCHED`. Each pair carries its
+//! margin over the best alternative for either joint, and a confidence from it.
+
+pub mod describe;
+pub mod names;
+
+use crate::skeleton::names::Side;
+use crate::skeleton::Skeleton;
+use describe::{describe, Described, Limb, Roles};
+use glam::DVec3;
+
+/// One skeleton: its joints and rest positions facing +z, y up (`AnyTopRig::rest_positions`).
+pub struct Body<'a> {
+    pub skeleton: &'a Skeleton,
+    pub rest: &'a [DVec3],
+}
+
+/// Which evidence to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Evidence {
+    /// Joint names (and sides and limb pairs from them).
+    pub names: bool,
+    /// Rest pose and topology (and sides and limb pairs from them when names are off or silent).
+    pub geometry: bool,
+}
+
+impl Evidence {
+    pub const ALL: Evidence = Evidence { names: true, geometry: true };
+    pub const NAMES: Evidence = Evidence { names: true, geometry: false };
+    pub const GEOMETRY: Evidence = Evidence { names: false, geometry: true };
+}
+
+/// Weight of an exact name, and of the same place in identical trees.
+const NAME_WEIGHT: f64 = 1.0;
+const SIGNATURE_WEIGHT: f64 = 1.0;
+/// Weights of the geometric terms (each term is about -1..1).
+const PLACE_WEIGHT: f64 = 0.35;
+const CHAIN_WEIGHT: f64 = 0.2;
+const ALONG_WEIGHT: f64 = 0.15;
+/// A midline joint with a limb joint, a leaf with a joint that has children.
+const CENTRE_WITH_SIDE: f64 = -0.3;
+const LEAF_WITH_INNER: f64 = -0.15;
+/// Weight of the extra similarity (cosine of DIFT features, -1..1).
+pub const EXTRA_WEIGHT: f64 = 0.2;
+/// Score of leaving a joint unmatched: a pair must score above this to be made.
+pub const UNMATCHED: f64 = -0.25;
+/// Larger skeletons than this (either) are assigned greedily: the Hungarian method is cubic.
+const HUNGARIAN_LIMIT: usize = 600;
+/// Bone chain length compared (joints, the joint included).
+const CHAIN: usize = 3;
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum CorrespondError {
+    #[error("{which} skeleton: {got} rest positions for {joints} joints")]
+    RestSize { which: &'static str, got: usize, joints: usize },
+    #[error("{which} skeleton has no joints")]
+    Empty { which: &'static str },
+    #[error("extra similarity is {rows} x {cols}, the skeletons have {source_joints} and {target_joints} joints")]
+    ExtraSize { rows: usize, cols: usize, source_joints: usize, target_joints: usize },
+}
+
+/// Every pair's score, `None` where a hard rule forbids the pair.
+pub struct Scores {
+    pub source: Described,
+    pub target: Described,
+    /// `[source][target]`.
+    pub score: Vec<Vec<Option<f64>>>,
+}
+
+/// A matched pair.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pair {
+    pub source: usize,
+    pub target: usize,
+    pub score: f64,
+    /// Score minus the best other pair either joint could have made (negative when the
+    /// one-to-one assignment overruled a joint's own first choice).
+    pub margin: f64,
+    /// 0..1 from the margin: 0.5 at a tie, near 1 when the pair is clearly the best for both.
+    pub confidence: f64,
+}
+
+/// Score every pair of `source` and `target` joints. `extra`, when given, is a similarity
+/// `[source][target]` (e.g. DIFT cosine) added with `EXTRA_WEIGHT`.
+pub fn scores(source: &Body, target: &Body, evidence: Evidence, extra: Option<&[Vec<f64>]>) -> Result<Scores, CorrespondError> {
+    for (which, body) in [("source", source), ("target", target)] {
+        if body.skeleton.is_empty() {
+            return Err(CorrespondError::Empty { which });
+        }
+        if body.rest.len() != body.skeleton.len() {
+            return Err(CorrespondError::RestSize { which, got: body.rest.len(), joints: body.skeleton.len() });
+        }
+    }
+    let (ns, nt) = (source.skeleton.len(), target.skeleton.len());
+    if let Some(x) = extra {
+        if x.len() != ns || x.iter().any(|r| r.len() != nt) {
+            return Err(CorrespondError::ExtraSize { rows: x.len(), cols: x.first().map_or(0, Vec::len), source_joints: ns, target_joints: nt });
+        }
+    }
+    // Sides and limb pairs from names only when both skeletons name their sides.
+    let named = |body: &Body| evidence.names && describe(body.skeleton, body.rest, true, Roles::Names).named_sides;
+    let roles = if named(source) && named(target) { Roles::Names } else { Roles::Geometry };
+    let a = describe(source.skeleton, source.rest, evidence.names, roles);
+    let b = describe(target.skeleton, target.rest, evidence.names, roles);
+    let score =
+        (0..ns).map(|s| (0..nt).map(|t| pair_score(&a, s, &b, t, evidence).map(|v| v + extra.map_or(0.0, |x| EXTRA_WEIGHT * x[s][t]))).collect()).collect();
+    Ok(Scores { source: a, target: b, score })
+}
+
+/// The joint and up to `len - 1` ancestors, stopping before the root.
+fn path(d: &Described, j: usize, len: usize) -> Vec<usize> {
+    let mut out = vec![j];
+    let mut cur = j;
+    while out.len() < len {
+        match d.parents[cur] {
+            Some(p) if d.parents[p].is_some() => {
+                out.push(p);
+                cur = p;
+            }
+            _ => break,
+        }
+    }
+    out
+}
+
+fn pair_score(a: &Described, s: usize, b: &Described, t: usize, evidence: Evidence) -> Option<f64> {
+    let (sa, sb) = (a.side[s], b.side[t]);
+    if a.has_sides && b.has_sides && matches!((sa, sb), (Side::Left, Side::Right) | (Side::Right, Side::Left)) {
+        return None;
+    }
+    let (la, lb) = (a.limb[s], b.limb[t]);
+    if matches!((la, lb), (Limb::Front, Limb::Hind) | (Limb::Hind, Limb::Front)) {
+        return None;
+    }
+    let mut score = 0.0;
+    if (sa == Side::Centre) != (sb == Side::Centre) && a.has_sides && b.has_sides {
+        score += CENTRE_WITH_SIDE;
+    }
+    if evidence.names {
+        if let Some(n) = names::similarity(&a.keys[s], &b.keys[t]) {
+            score += NAME_WEIGHT * n;
+        }
+    }
+    if evidence.geometry {
+        if a.signature[s] == b.signature[t] {
+            score += SIGNATURE_WEIGHT;
+        }
+        let distance = (a.place[s] - b.place[t]).length();
+        score += PLACE_WEIGHT * (1.0 - 2.0 * distance).max(-1.0);
+        let (pa, pb) = (path(a, s, CHAIN), path(b, t, CHAIN));
+        let len = pa.len().min(pb.len());
+        score += CHAIN_WEIGHT * (0..len).map(|k| a.direction[pa[k]].dot(b.direction[pb[k]])).sum::<f64>() / len as f64;
+        if (la == Limb::Centre) == (lb == Limb::Centre) {
+            score += ALONG_WEIGHT * (1.0 - 2.0 * (a.along[s] - b.along[t]).abs());
+        }
+        if a.leaf[s] != b.leaf[t] {
+            score += LEAF_WITH_INNER;
+        }
+    }
+    Some(score)
+}
+
+/// One-to-one pairs maximising the total score, in source order. Pairs scoring at most
+/// `UNMATCHED` are not made.
+pub fn assign(scores: &Scores) -> Vec<Pair> {
+    let ns = scores.score.len();
+    let nt = scores.score.first().map_or(0, Vec::len);
+    if ns == 0 || nt == 0 {
+        return Vec::new();
+    }
+    let chosen: Vec<Option<usize>> = if ns.max(nt) <= HUNGARIAN_LIMIT { hungarian(&scores.score, nt) } else { greedy(&scores.score, nt) };
+    let mut out = Vec::new();
+    for (s, t) in chosen.into_iter().enumerate() {
+        let Some(t) = t else { continue };
+        let Some(score) = scores.score[s][t] else { continue };
+        if score <= UNMATCHED {
+            continue;
+        }
+        let row = scores.score[s].iter().enumerate().filter(|&(k, _)| k != t).filter_map(|(_, v)| *v);
+        let col = scores.score.iter().enumerate().filter(|&(k, _)| k != s).filter_map(|(_, r)| r[t]);
+        let other = row.chain(col).fold(UNMATCHED, f64::max);
+        let margin = score - other;
+        out.push(Pair { source: s, target: t, score, margin, confidence: (0.5 + margin).clamp(0.0, 1.0) });
+    }
+    out
+}
+
+/// Integer weights for the Hungarian method (it needs an ordered type): micro-units.
+fn weight(v: f64) -> i64 {
+    (v * 1e6).round() as i64
+}
+
+/// Kuhn-Munkres on `[source][target + source]`: the extra columns are "unmatched" at
+/// `UNMATCHED`, so rows never outnumber columns and a poor pair can be declined.
+fn hungarian(score: &[Vec<Option<f64>>], nt: usize) -> Vec<Option<usize>> {
+    let ns = score.len();
+    let cols = nt + ns;
+    let forbidden = weight(-1e3);
+    let mut values = Vec::with_capacity(ns * cols);
+    for row in score {
+        values.extend(row.iter().map(|v| v.map_or(forbidden, weight)));
+        values.extend(std::iter::repeat_n(weight(UNMATCHED), ns));
+    }
+    let Ok(matrix) = pathfinding::matrix::Matrix::from_vec(ns, cols, values) else { return greedy(score, nt) };
+    let (_, columns) = pathfinding::kuhn_munkres::kuhn_munkres(&matrix);
+    columns.into_iter().map(|c| (c < nt).then_some(c)).collect()
+}
+
+/// Highest score first, each joint once (ties by index).
+fn greedy(score: &[Vec<Option<f64>>], nt: usize) -> Vec<Option<usize>> {
+    let mut all: Vec<(f64, usize, usize)> =
+        score.iter().enumerate().flat_map(|(s, r)| r.iter().enumerate().filter_map(move |(t, v)| v.map(|v| (v, s, t)))).collect();
+    all.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut out = vec![None; score.len()];
+    let mut used = vec![false; nt];
+    for (_, s, t) in all {
+        if out[s].is_none() && !used[t] {
+            out[s] = Some(t);
+            used[t] = true;
+        }
+    }
+    out
+}
+
+/// For every target joint, its source joint: the one-to-one pair when it has one, else the
+/// best-scoring allowed source (`one_to_one` false), else none (every source forbidden).
+pub fn per_target(scores: &Scores, pairs: &[Pair]) -> Vec<(usize, Option<(Pair, bool)>)> {
+    let nt = scores.score.first().map_or(0, Vec::len);
+    (0..nt)
+        .map(|t| {
+            if let Some(p) = pairs.iter().find(|p| p.target == t) {
+                return (t, Some((p.clone(), true)));
+            }
+            let best = scores.score.iter().enumerate().filter_map(|(s, r)| r[t].map(|v| (s, v))).fold(None, |best: Option<(usize, f64)>, (s, v)| match best {
+                Some((_, b)) if b >= v => best,
+                _ => Some((s, v)),
+            });
+            (t, best.map(|(s, v)| (Pair { source: s, target: t, score: v, margin: 0.0, confidence: 0.0 }, false)))
+        })
+        .collect()
+}
+
+/// Pairs that may be bound: both joints move a bone (not the root, not leaves), the same side
+/// and the same limb pair (or both on the midline). Highest score first.
+pub fn compatible(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
+    let (a, b) = (&scores.source, &scores.target);
+    let inner = |d: &Described, j: usize| d.parents[j].is_some() && !d.leaf[j];
+    let mut out: Vec<Pair> = pairs
+        .iter()
+        .filter(|p| inner(a, p.source) && inner(b, p.target))
+        .filter(|p| !(a.has_sides && b.has_sides) || a.side[p.source] == b.side[p.target])
+        .filter(|p| a.limb[p.source] == b.limb[p.target])
+        .cloned()
+        .collect();
+    out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.source.cmp(&y.source)).then(x.target.cmp(&y.target)));
+    out
+}
+
+/// The compatible pairs worth binding: confident (neither joint had a better partner,
+/// `margin` >= 0, and the evidence is positive overall) and not feet or toes. Feet stay with
+/// the examples: a foot's rotation is mostly its contact with the ground, which the target's
+/// own clips know and another species' foot does not; binding them lowered frequency
+/// alignment on Flamingo -> Monkey from 0.95 to 0.85 (docs/retarget-results.md).
+pub fn bindable(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
+    let (a, b) = (&scores.source, &scores.target);
+    compatible(scores, pairs).into_iter().filter(|p| p.margin >= 0.0 && p.score > 0.0 && !a.foot[p.source] && !b.foot[p.target]).collect()
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::synth;
+
+    /// A zoo creature and its rest positions (also for `binding::auto`'s tests).
+    pub(crate) fn body_of(name: &str) -> (Skeleton, Vec<DVec3>) {
+        let (skeleton, _) = synth::creature(name, 1).unwrap();
+        let rest = skeleton.rest_positions();
+        (skeleton, rest)
+    }
+
+    #[test]
+    fn a_skeleton_matches_itself_with_any_evidence() {
+        for name in ["biped", "quadruped", "spider", "centipede"] {
+            let (s, rest) = body_of(name);
+            let body = Body { skeleton: &s, rest: &rest };
+            for ev in [Evidence::ALL, Evidence::NAMES, Evidence::GEOMETRY] {
+                let sc = scores(&body, &body, ev, None).unwrap();
+                let pairs = assign(&sc);
+                let right = pairs.iter().filter(|p| p.source == p.target).count();
+                assert_eq!(right, s.len(), "{name} {ev:?}: {right} of {}", s.len());
+            }
+        }
+    }
+
+    #[test]
+    fn spider_and_centipede_legs_keep_their_numbers_and_pairs() {
+        for name in ["spider", "centipede"] {
+            let (s, rest) = body_of(name);
+            let d = describe(&s, &rest, true, Roles::Names);
+            let legs: Vec<usize> = (0..s.len()).filter(|&j| d.side[j] == Side::Left && d.keys[j].words.contains(&"leg".to_string())).collect();
+            let mut ordinals: Vec<u64> = legs.iter().flat_map(|&j| d.keys[j].ordinals.clone()).collect();
+            ordinals.sort();
+            ordinals.dedup();
+            assert!(ordinals.len() >= 4, "{name}: ordinals {ordinals:?}");
+            // The legs split into front and hind pairs by the rest pose.
+            assert!(legs.iter().any(|&j| d.limb[j] == Limb::Front) && legs.iter().any(|&j| d.limb[j] == Limb::Hind), "{name}");
+        }
+    }
+
+    #[test]
+    fn never_left_with_right_nor_front_with_hind() {
+        let (b, rb) = body_of("biped");
+        let (q, rq) = body_of("quadruped");
+        let sc = scores(&Body { skeleton: &b, rest: &rb }, &Body { skeleton: &q, rest: &rq }, Evidence::ALL, None).unwrap();
+        for p in assign(&sc) {
+            let (x, y) = (sc.source.side[p.source], sc.target.side[p.target]);
+            assert!(!matches!((x, y), (Side::Left, Side::Right) | (Side::Right, Side::Left)), "{p:?}");
+            let (x, y) = (sc.source.limb[p.source], sc.target.limb[p.target]);
+            assert!(!matches!((x, y), (Limb::Front, Limb::Hind) | (Limb::Hind, Limb::Front)), "{p:?}");
+        }
+        let short = Body { skeleton: &b, rest: &rb[..2] };
+        assert!(matches!(scores(&short, &short, Evidence::ALL, None), Err(CorrespondError::RestSize { .. })));
+    }
+}
