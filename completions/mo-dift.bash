@@ -23,7 +23,7 @@ _mo__dift() {
 
     case "${cmd}" in
         mo__dift)
-            opts="-o -q -v -h -V --joints --frames --align --as-binding --bind-rate --t --layer --draws --model --skeleton --output --seed --quiet --verbose --threads --animation --fps --help --version"
+            opts="-o -q -v -h -V --joints --frames --align --as-binding --bind-rate --features --t --layer --draws --model --skeleton --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -35,6 +35,10 @@ _mo__dift() {
                     ;;
                 --bind-rate)
                     COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --features)
+                    COMPREPLY=($(compgen -W "combined dift-only" -- "${cur}"))
                     return 0
                     ;;
                 --t)

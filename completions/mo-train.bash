@@ -23,7 +23,7 @@ _mo__train() {
 
     case "${cmd}" in
         mo__train)
-            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --augment --augment-variants --ema --noise-shift --loss-weighting --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --help --version"
+            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --augment --augment-variants --ema --noise-shift --loss-weighting --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -118,6 +118,14 @@ _mo__train() {
                     return 0
                     ;;
                 --threads)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --animation)
+                    COMPREPLY=($(compgen -f "${cur}"))
+                    return 0
+                    ;;
+                --fps)
                     COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
