@@ -14,6 +14,11 @@ fn cosine_alpha_bar(s: f64) -> f64 {
     x.cos().powi(2)
 }
 
+/// The signal-to-noise ratio ᾱ / (1 − ᾱ) of a step with ᾱ = `alpha_bar` (infinite at ᾱ = 1).
+pub fn signal_to_noise(alpha_bar: f64) -> f64 {
+    alpha_bar / (1.0 - alpha_bar)
+}
+
 /// The noise schedule of T steps: β_t and ᾱ_t for t = 0..T-1.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Schedule {
@@ -48,7 +53,7 @@ impl Schedule {
             .alpha_bars
             .iter()
             .map(|&ab| {
-                let log_snr = (ab / (1.0 - ab)).ln() - offset;
+                let log_snr = signal_to_noise(ab).ln() - offset;
                 1.0 / (1.0 + (-log_snr).exp())
             })
             .collect();
@@ -180,10 +185,9 @@ mod tests {
         assert_eq!(Schedule::cosine_shifted(100, 1.0), plain);
         let shifted = Schedule::cosine_shifted(100, 4.0);
         assert_eq!(shifted.len(), 100);
-        let snr = |ab: f64| ab / (1.0 - ab);
         for t in 0..99 {
             let (p, s) = (plain.alpha_bars[t], shifted.alpha_bars[t]);
-            assert!((snr(s) * 16.0 / snr(p) - 1.0).abs() < 1e-6, "t = {t}: {s} against {p}");
+            assert!((signal_to_noise(s) * 16.0 / signal_to_noise(p) - 1.0).abs() < 1e-6, "t = {t}: {s} against {p}");
             assert!(shifted.alpha_bars[t + 1] < s, "ᾱ falls at t = {t}");
         }
     }

@@ -250,7 +250,7 @@ impl Weighting {
 
     /// The weight of every step of `schedule`, averaging 1.
     pub fn weights(self, schedule: &Schedule) -> Vec<f64> {
-        let raw: Vec<f64> = schedule.alpha_bars.iter().map(|&ab| self.raw(ab / (1.0 - ab).max(f64::MIN_POSITIVE))).collect();
+        let raw: Vec<f64> = schedule.alpha_bars.iter().map(|&ab| self.raw(super::schedule::signal_to_noise(ab))).collect();
         let mean = raw.iter().sum::<f64>() / raw.len().max(1) as f64;
         raw.iter().map(|w| if mean > 0.0 { w / mean } else { 1.0 }).collect()
     }
@@ -1020,7 +1020,7 @@ mod tests {
         assert!(m[0] > 100.0 * m[60], "{} {}", m[0], m[60]);
         // A cap below every step's SNR weighs them all alike.
         let schedule = Schedule::cosine(100);
-        let floor = schedule.alpha_bars.iter().map(|ab| ab / (1.0 - ab)).fold(f64::INFINITY, f64::min);
+        let floor = schedule.alpha_bars.iter().map(|&ab| super::super::schedule::signal_to_noise(ab)).fold(f64::INFINITY, f64::min);
         assert!(Weighting::MinSnr(floor / 2.0).weights(&schedule).iter().all(|&x| (x - 1.0).abs() < 1e-12));
     }
 
