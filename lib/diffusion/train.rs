@@ -286,8 +286,9 @@ impl std::str::FromStr for Weighting {
     }
 }
 
-/// The crops of one skeleton (or augmented variant) in a step, in batch order, with their
-/// diffusion steps and the noise drawn for them: one sub-batch of the model.
+/// The crops of one skeleton (or augmented variant) in a step, or a part of them (see
+/// `MAX_SUB_BATCH`), in batch order, with their diffusion steps and the noise drawn for them:
+/// one sub-batch of the model.
 pub struct GroupDraw {
     pub crops: Vec<Crop>,
     pub steps: Vec<u32>,
@@ -313,9 +314,36 @@ pub struct StepDraw {
     pub velocity_values: Option<f64>,
 }
 
-/// Draw `batch` crops and timesteps, group the crops by skeleton (or variant), and draw each
-/// group's noise (see `StepDraw`).
+/// The most crops one sub-batch of the model takes. A skeleton with more crops in a step is
+/// split into near-equal sub-batches, so that a batch of one skeleton (fine-tuning, or the
+/// paper's single-creature runs) still gives the threads separate work: one sub-batch's
+/// backward pass is mostly small elementwise ops that run on one thread, which is why one
+/// 16-crop group gained only 1.19x from a second core (issue 28). The split depends only on
+/// the crops, never on the thread count, so the bytes stay the same at any `--threads`, and
+/// the model gives a crop the same output in any sub-batch, so only the cost changes.
+/// Why 4: a paper-width sub-batch of 4 crops of 41 frames of a 43-joint creature keeps its
+/// largest activation (7k tokens x ff 1024 floats) under glibc's 32 MiB mmap threshold (see
+/// `nn::keep_freed_memory`), so it is reused instead of page-faulted afresh every step, while
+/// its matmuls still have thousands of rows (measured in BENCHMARKS.md, "Training step").
+pub const MAX_SUB_BATCH: usize = 4;
+
+/// `items` in order, cut into the fewest runs of at most `most` items, of near-equal length
+/// (the first runs take the one extra item).
+fn split_evenly(items: Vec<usize>, most: usize) -> Vec<Vec<usize>> {
+    let runs = items.len().div_ceil(most.max(1)).max(1);
+    let (base, extra) = (items.len() / runs, items.len() % runs);
+    let mut rest = items.into_iter();
+    (0..runs).map(|r| rest.by_ref().take(base + usize::from(r < extra)).collect()).filter(|run: &Vec<usize>| !run.is_empty()).collect()
+}
+
+/// Draw `batch` crops and timesteps, group the crops by skeleton (or variant), split large
+/// groups into sub-batches (`MAX_SUB_BATCH`), and draw each sub-batch's noise (see
+/// `StepDraw`).
 pub fn draw_step(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batch: usize, crop: usize) -> Result<StepDraw, NnError> {
+    draw_split(set, schedule, rng, batch, crop, MAX_SUB_BATCH)
+}
+
+fn draw_split(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batch: usize, crop: usize, most: usize) -> Result<StepDraw, NnError> {
     let crops = set.sample(rng, batch, crop);
     let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
     let mut order: Vec<(usize, Option<usize>)> = Vec::new();
@@ -330,8 +358,11 @@ pub fn draw_step(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batc
     let (mut tokens, mut pairs, mut velocity) = (0usize, 0usize, true);
     let mut dims = 0;
     let mut groups = Vec::with_capacity(order.len());
-    for key in order {
+    let parts = order.iter().flat_map(|&key| {
         let chosen: Vec<usize> = (0..crops.len()).filter(|&i| (crops[i].skeleton, crops[i].variant) == key).collect();
+        split_evenly(chosen, most)
+    });
+    for chosen in parts {
         let part_crops: Vec<Crop> = chosen.iter().map(|&i| crops[i]).collect();
         let part_steps: Vec<u32> = chosen.iter().map(|&i| steps[i]).collect();
         let clip = |c: &Crop| &set.data(c).clips[c.clip];
@@ -842,6 +873,79 @@ mod tests {
                 let worst = w.iter().zip(&sum).fold(0f32, |m, (a, b)| m.max((a - b).abs()));
                 assert!(worst <= 1e-4 * scale, "{name} (geo {geo}, vel {vel}): off by {worst}, largest {scale}");
             }
+        }
+    }
+
+    #[test]
+    fn split_evenly_makes_the_fewest_near_equal_runs() {
+        let runs = |n: usize, most: usize| split_evenly((0..n).collect(), most).iter().map(Vec::len).collect::<Vec<_>>();
+        assert_eq!(runs(16, 8), vec![8, 8]);
+        assert_eq!(runs(17, 8), vec![6, 6, 5]);
+        assert_eq!(runs(3, 8), vec![3]);
+        assert!(runs(0, 8).is_empty());
+        assert_eq!(split_evenly((0..5).collect(), 2), vec![vec![0, 1], vec![2, 3], vec![4]]);
+    }
+
+    /// Rows `from..to` of a group (crops, steps and their noise) as a group of its own.
+    fn rows(group: &GroupDraw, from: usize, to: usize) -> GroupDraw {
+        let (_, t, j, d) = group.shape;
+        let per = t * j * d;
+        GroupDraw {
+            crops: group.crops[from..to].to_vec(),
+            steps: group.steps[from..to].to_vec(),
+            shape: (to - from, t, j, d),
+            noise: group.noise[from * per..to * per].to_vec(),
+        }
+    }
+
+    #[test]
+    fn splitting_a_skeletons_crops_into_sub_batches_changes_neither_loss_nor_gradient() {
+        let (skeleton, motion) = crate::synth::creature("quadruped", 1).unwrap();
+        let clips = vec![RawClip { name: "q.bvh".into(), skeleton, motion }];
+        let set = TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &Augmentation::none()).unwrap().0;
+        let schedule = Schedule::cosine(100);
+        // One skeleton, more crops than a sub-batch takes: the step splits it.
+        let batch = MAX_SUB_BATCH + 3;
+        let draw = draw_step(&set, &schedule, &mut SplitMix64::new(3), batch, 12).unwrap();
+        let sizes: Vec<usize> = draw.groups.iter().map(|g| g.crops.len()).collect();
+        assert!(sizes.len() > 1 && sizes.iter().all(|&n| n <= MAX_SUB_BATCH) && sizes.iter().sum::<usize>() == batch, "{sizes:?}");
+        // The same step as one group, and that group cut by hand into the same parts.
+        let whole = draw_split(&set, &schedule, &mut SplitMix64::new(3), batch, 12, usize::MAX).unwrap();
+        assert_eq!(whole.groups.len(), 1);
+        let g = &whole.groups[0];
+        assert_eq!(g.shape.1, 13, "every crop is full length, so the parts keep the group's shape");
+        let mut from = 0;
+        let groups = sizes
+            .iter()
+            .map(|&n| {
+                from += n;
+                rows(g, from - n, from)
+            })
+            .collect();
+        let parts = StepDraw { groups, tokens: whole.tokens, dims: whole.dims, velocity_values: whole.velocity_values };
+        let dev = Device::Cpu;
+        let varmap = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&varmap, 6, &dev), &DenoiserConfig::tiny()).unwrap();
+        let terms = LossTerms { geo: 1.0, vel: 0.5, weighting: Weighting::V };
+        let (a, ga) = step_gradients(&model, &set, &schedule, &whole, terms, &dev).unwrap();
+        let (b, gb) = step_gradients(&model, &set, &schedule, &parts, terms, &dev).unwrap();
+        // f32 sums in another order: rounding only.
+        assert!((a - b).abs() < 1e-4 * a.abs(), "loss {a} whole, {b} split");
+        for (name, var) in named_vars(&varmap) {
+            let sum = |stores: &[GradStore]| {
+                let mut out: Vec<f32> = Vec::new();
+                for s in stores {
+                    let g = s.get(var.as_tensor()).unwrap().flatten_all().unwrap().to_vec1::<f32>().unwrap();
+                    out.resize(g.len(), 0.0);
+                    out.iter_mut().zip(&g).for_each(|(o, v)| *o += v);
+                }
+                out
+            };
+            let (w, s) = (sum(&ga), sum(&gb));
+            // The floor: a key bias's gradient is zero up to rounding (softmax ignores it).
+            let scale = w.iter().fold(0f32, |m, v| m.max(v.abs())).max(1e-6);
+            let worst = w.iter().zip(&s).fold(0f32, |m, (x, y)| m.max((x - y).abs()));
+            assert!(worst <= 1e-4 * scale, "{name}: off by {worst}, largest {scale}");
         }
     }
 
