@@ -26,7 +26,14 @@ pub struct NameKey {
     /// keys agree but whose spellings differ (Rigify's `ORG_Pelvis` and `DEF_Pelvis`) are told
     /// apart by it.
     pub spelling: String,
+    /// Rigify's bone layer when the name starts with one (`org`, `def`, `mch`): the same body
+    /// part in two layers is two bones (the original and its deform copy), so two names that
+    /// agree but for their layer are a weaker match than two that agree and share no layer word.
+    pub layer: Option<String>,
 }
+
+/// Rigify's bone layers, as name prefixes.
+const LAYERS: &[&str] = &["org", "def", "mch"];
 
 impl NameKey {
     /// A name that says nothing (numbers only, or a bare rig prefix): no evidence.
@@ -62,8 +69,11 @@ pub enum LimbWord {
 pub fn key(raw: &str) -> NameKey {
     let mut words = split_words(raw);
     let spelling = words.join("_").to_ascii_lowercase();
+    let prefixed = words.clone();
     drop_rig_prefixes(&mut words);
-    let mut out = NameKey { spelling, ..NameKey::default() };
+    let dropped = prefixed.len() - words.len();
+    let layer = prefixed.into_iter().take(dropped).map(|w| w.to_ascii_lowercase()).find(|w| LAYERS.contains(&w.as_str()));
+    let mut out = NameKey { spelling, layer, ..NameKey::default() };
     let mut body: Vec<String> = Vec::new();
     for w in &words {
         let lower = w.to_ascii_lowercase();
@@ -115,15 +125,29 @@ pub fn limb_word(key: &NameKey) -> Option<LimbWord> {
     })
 }
 
+/// The similarity of one body part's names in two Rigify layers (`ORG_Pelvis`, `DEF_Pelvis`):
+/// above any partial match (at most 0.8) and below the same part without layer words (1), so
+/// that the right layer wins by 0.25 rather than by the spelling's 0.1, which the rest-pose
+/// terms could outweigh (a skel-aug variant of the Crab paired `ORG_BN_Bip01_Pelvis` with
+/// `DEF_BN_Bip01_Pelvis`, its child at the same place).
+const LAYER_MISMATCH: f64 = 0.85;
+
 /// How alike two names are, 0..1.1: 1 for the same side, words and ordinals (1.1 when spelt
-/// the same too); otherwise the share of words in common, lowered when both carry ordinals
+/// the same too, `LAYER_MISMATCH` when they name two Rigify layers of that part); otherwise the share of words in common, lowered when both carry ordinals
 /// that differ. `None` when either name says nothing.
 pub fn similarity(a: &NameKey, b: &NameKey) -> Option<f64> {
     if a.is_blank() || b.is_blank() {
         return None;
     }
     if a.words == b.words && a.ordinals == b.ordinals && a.side == b.side {
-        return Some(if a.spelling == b.spelling { 1.1 } else { 1.0 });
+        let other_layer = matches!((&a.layer, &b.layer), (Some(x), Some(y)) if x != y);
+        return Some(if a.spelling == b.spelling {
+            1.1
+        } else if other_layer {
+            LAYER_MISMATCH
+        } else {
+            1.0
+        });
     }
     let shared = a.words.iter().filter(|w| b.words.contains(w)).count();
     let union = a.words.len() + b.words.len() - shared;
@@ -166,5 +190,12 @@ mod tests {
         let same_leg = similarity(&key("leg_l1_femur"), &key("leg_l1_tibia")).unwrap();
         assert!(near < 1.0 && near > 0.0 && same_leg > 0.0, "{near} {same_leg}");
         assert_eq!(similarity(&key("3"), &key("Hips")), None);
+        // Rigify layers: the same layer (or none) beats another layer of the same part.
+        assert_eq!(key("ORG_BN_Bip01_Pelvis").layer.as_deref(), Some("org"));
+        assert_eq!(key("Pelvis").layer, None);
+        let same = similarity(&key("ORG_BN_Bip01_Pelvis"), &key("ORG_BN_Bip01_Pelvis")).unwrap();
+        let other = similarity(&key("ORG_BN_Bip01_Pelvis"), &key("DEF_BN_Bip01_Pelvis")).unwrap();
+        let plain = similarity(&key("ORG_BN_Bip01_Pelvis"), &key("Bip01_Pelvis")).unwrap();
+        assert!(same > plain && plain > other && other > 0.8, "{same} {plain} {other}");
     }
 }
