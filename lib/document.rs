@@ -192,7 +192,7 @@ impl From<AnyTopError> for DocumentError {
 impl SkeletonDocument {
     /// The document of a skeleton; `motion` (a summary, see `MotionInfo::of`) when the file had frames.
     pub fn build(skeleton: &Skeleton, motion: Option<MotionInfo>, source: &str, dmax: usize) -> SkeletonDocument {
-        let normalised: Vec<String> = skeleton.joints.iter().map(|j| names::normalise(&j.name)).collect();
+        let normalised: Vec<String> = skeleton.joints.iter().map(|j| names::readable(&j.name)).collect();
         let sides = roles::sides(skeleton, &normalised);
         let (feet, foot_rule) = roles::feet(skeleton);
         let end_effectors = topology::end_effectors(skeleton);

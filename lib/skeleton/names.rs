@@ -10,7 +10,8 @@
 //! 2. split at `_ - . :` and spaces, before capitals (`LeftUpLeg`, `LHipJoint` -> L Hip Joint)
 //!    and between letters and digits;
 //! 3. drop leading rig prefixes (`Bip01`, `BN`, `NPC`, `jt`, `ORG`, `DEF`, `MCH`, `joint`...);
-//! 4. drop numbers and one-letter words, except `L`/`R` which become Left/Right; translate
+//! 4. drop numbers (`readable` keeps them as ordinals) and one-letter words, except `L`/`R`
+//!    which become Left/Right; translate
 //!    AnyTop's Japanese words (`momo` -> Thigh ...) and `Tai` -> Tail; split `lhand` -> l hand
 //!    for a few body words;
 //! 5. move the side word to the front, capitalise each word, join with spaces.
@@ -143,8 +144,23 @@ pub(crate) fn classify(lower: &str) -> Word<'_> {
     Word::Plain
 }
 
-/// The normalised, readable name of a raw joint name.
+/// The normalised name of a raw joint name, numbers dropped: the key of the name embeddings
+/// (`embed`). The built-in models were trained on exactly these strings, so it stays as it is;
+/// `leg_l1_coxa` ... `leg_l4_coxa` all give "Left Leg Coxa" here. For people and for matching
+/// use `readable`, which keeps the ordinals.
 pub fn normalise(raw: &str) -> String {
+    joined(raw, false)
+}
+
+/// The readable name of a raw joint name: `normalise` with the numbers kept in place, without
+/// leading zeros (`leg_l1_coxa` -> "Left Leg 1 Coxa", `Tail_03` -> "Tail 3", `Spine1` ->
+/// "Spine 1"), so that four legs or three spine joints do not read as one. What `skel-info`
+/// shows as `normalised`.
+pub fn readable(raw: &str) -> String {
+    joined(raw, true)
+}
+
+fn joined(raw: &str, numbers: bool) -> String {
     let mut words = split_words(raw);
     drop_rig_prefixes(&mut words);
     let mut side: Option<Side> = None;
@@ -152,6 +168,10 @@ pub fn normalise(raw: &str) -> String {
     for w in &words {
         let lower = w.to_ascii_lowercase();
         match classify(&lower) {
+            Word::Number if numbers => out.push(match lower.trim_start_matches('0') {
+                "" => "0".to_string(),
+                digits => digits.to_string(),
+            }),
             Word::Number => {}
             Word::Side(s) => {
                 side.get_or_insert(s);
@@ -193,7 +213,29 @@ pub fn side_from_name(normalised: &str) -> Option<Side> {
 
 #[cfg(test)]
 mod tests {
-    use super::normalise;
+    use super::{normalise, readable};
+
+    #[test]
+    fn readable_names_keep_ordinals_and_tell_legs_apart() {
+        assert_eq!(readable("leg_l1_coxa"), "Left Leg 1 Coxa");
+        assert_eq!(readable("Tail_03"), "Tail 3");
+        assert_eq!(readable("Bip01_R_Finger0"), "Right Finger 0");
+        assert_eq!(readable("mixamorig:LeftHandIndex1"), "Left Hand Index 1");
+        assert_eq!(readable("Bip01_L_Foot__ouF"), "Left Foot");
+        // What the issue saw: the embedding key still merges the four legs, the readable name
+        // does not, on the spider and the centipede.
+        assert_eq!(normalise("leg_l1_coxa"), normalise("leg_l4_coxa"));
+        for creature in ["spider", "centipede"] {
+            let (skeleton, _) = crate::synth::creature(creature, 0).unwrap();
+            let names: Vec<String> = skeleton.joints.iter().map(|j| readable(&j.name)).collect();
+            let mut unique = names.clone();
+            unique.sort();
+            unique.dedup();
+            assert_eq!(unique.len(), names.len(), "{creature}: {names:?}");
+            let keys: std::collections::BTreeSet<String> = skeleton.joints.iter().map(|j| normalise(&j.name)).collect();
+            assert!(keys.len() < names.len(), "{creature}: the embedding key merges legs");
+        }
+    }
 
     #[test]
     fn spellings_of_one_part_agree() {
