@@ -10,7 +10,7 @@
 use crate::bvh::Bvh;
 use crate::bvh::Channel;
 use crate::motion::Motion;
-use crate::repr::anytop::{AnyTopError, AnyTopOptions, AnyTopRig, AnyTopStats, RestSource, FEATURE_DIMS};
+use crate::repr::anytop::{AnyTopError, RigOptions, AnyTopRig, AnyTopStats, RestSource, FEATURE_DIMS};
 use crate::skeleton::names::{self, Side};
 use crate::skeleton::roles::{self, FootRule};
 use crate::skeleton::{topology, Joint, Skeleton, Stats};
@@ -55,7 +55,7 @@ pub struct AnyTopSection {
 impl AnyTopSection {
     /// Rig and P_S from `rest` (its frame 0 is the rest pose, frame 1 gives P_S its velocity),
     /// without statistics.
-    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &AnyTopOptions) -> Result<AnyTopSection, AnyTopError> {
+    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &RigOptions) -> Result<AnyTopSection, AnyTopError> {
         let rig = AnyTopRig::new(skeleton, rest, options)?;
         let row = rig.rest_features(skeleton, rest)?;
         let rest_row = (0..row.joints).map(|j| row.at(0, j).to_vec()).collect();
@@ -82,13 +82,13 @@ impl AnyTopSection {
     /// The record of a lone clip: the rig on its own first two frames (AnyTop's rule without a
     /// T-pose file, the rig `mo-encode` builds for a single input), no statistics.
     pub fn of_clip(skeleton: &Skeleton, motion: &Motion, file: &str) -> Result<AnyTopSection, AnyTopError> {
-        let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..AnyTopOptions::default() };
+        let options = RigOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..RigOptions::default() };
         AnyTopSection::new(skeleton, &motion.first_frames(2), &options)
     }
 
     /// `new` with default options, plus statistics over `clips` (those with at least two frames).
     pub fn build(skeleton: &Skeleton, rest: &Motion, source: RestSource, clips: &[&Motion]) -> Result<AnyTopSection, AnyTopError> {
-        let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
+        let options = RigOptions { rest_source: source, ..RigOptions::default() };
         let mut section = AnyTopSection::new(skeleton, rest, &options)?;
         let mut features = Vec::new();
         for clip in clips.iter().filter(|m| m.frames >= 2) {

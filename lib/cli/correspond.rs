@@ -6,14 +6,14 @@ use crate::binding::auto::{self, AutoOptions, Body, Choice};
 use crate::correspond::{self, Evidence, Scores};
 use crate::document::AnyTopSection;
 use crate::motion::Motion;
-use crate::repr::anytop::AnyTopOptions;
+use crate::repr::anytop::RigOptions;
 use crate::skeleton::Skeleton;
 use anyhow::Context;
 use glam::DVec3;
 
 /// The AnyTop rig's natural rest pose: faces +z, so two creatures compare in one frame.
 pub fn facing_rest(skeleton: &Skeleton, motion: &Motion, name: &str) -> anyhow::Result<Vec<DVec3>> {
-    let section = AnyTopSection::new(skeleton, &motion.first_frames(2), &AnyTopOptions::default())
+    let section = AnyTopSection::new(skeleton, &motion.first_frames(2), &RigOptions::default())
         .with_context(|| format!("{name}: cannot find its rest pose and facing"))?;
     Ok(section.rig.rest_positions(skeleton))
 }

@@ -7,15 +7,15 @@ use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::io::{self, npy};
 use crate::motion::Motion;
-use crate::sata::checkpoint::{self, Frozen};
-use crate::sata::infer::{Latents, Prepared};
+use crate::sata::checkpoint::{self, FrozenAutoencoder};
+use crate::sata::infer::{Latents, PreparedSkeleton};
 use crate::skeleton::Skeleton;
 use anyhow::{bail, Context};
 use candle_core::Device;
 use std::path::Path;
 
 /// `--model DIR`, or the built-in latent model.
-pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<Frozen> {
+pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<FrozenAutoencoder> {
     Ok(match dir {
         Some(dir) => checkpoint::frozen(dir, device)?,
         None => checkpoint::frozen_default(device)?,
@@ -25,7 +25,7 @@ pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<Frozen>
 /// The rig to read or write `skeleton`'s motion with, and the skeleton it fits: the model's
 /// training rig when it knows the skeleton (`sata::rigs`: the rest pose its rotations are
 /// measured from, on the offsets it trained with), else `own` (the clip's or document's).
-fn rig_for(model: &Frozen, skeleton: &Skeleton, own: impl FnOnce() -> anyhow::Result<AnyTopSection>) -> anyhow::Result<(AnyTopSection, Skeleton)> {
+fn rig_for(model: &FrozenAutoencoder, skeleton: &Skeleton, own: impl FnOnce() -> anyhow::Result<AnyTopSection>) -> anyhow::Result<(AnyTopSection, Skeleton)> {
     match model.rigs.find(skeleton) {
         Some(known) => Ok((known.section.clone(), known.fit(skeleton))),
         None => Ok((own()?, skeleton.clone())),
@@ -39,10 +39,10 @@ pub struct SourceClip {
     pub name: String,
     pub skeleton: Skeleton,
     pub motion: Motion,
-    pub prepared: Prepared,
+    pub prepared: PreparedSkeleton,
 }
 
-pub fn read_source(path: &Path, model: &Frozen, device: &Device) -> anyhow::Result<SourceClip> {
+pub fn read_source(path: &Path, model: &FrozenAutoencoder, device: &Device) -> anyhow::Result<SourceClip> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
     if bytes.starts_with(b"\x93NUMPY") {
@@ -57,7 +57,7 @@ pub fn read_source(path: &Path, model: &Frozen, device: &Device) -> anyhow::Resu
     }
     let (section, skeleton) =
         rig_for(model, &skeleton, || AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig")))?;
-    let prepared = Prepared::new(&skeleton, section, names()?, device).with_context(|| name.clone())?;
+    let prepared = PreparedSkeleton::new(&skeleton, section, names()?, device).with_context(|| name.clone())?;
     Ok(SourceClip { name, skeleton, motion, prepared })
 }
 
@@ -66,7 +66,7 @@ fn names() -> anyhow::Result<&'static NameTable> {
 }
 
 /// Per-frame latents of a clip (`[frames - 1, latent]`: AnyTop's features need a next frame).
-pub fn encode(model: &Frozen, clip: &SourceClip, device: &Device) -> anyhow::Result<Latents> {
+pub fn encode(model: &FrozenAutoencoder, clip: &SourceClip, device: &Device) -> anyhow::Result<Latents> {
     let encoded = clip.prepared.section.rig.encode(&clip.skeleton, &clip.motion).with_context(|| format!("{}: cannot encode", clip.name))?;
     if let Some((f, j, d)) = encoded.features.first_non_finite() {
         bail!("{}: non-finite feature at frame {f}, joint {j}, dim {d}", clip.name);
@@ -80,13 +80,13 @@ pub struct Target {
     pub arg: SkeletonArg,
     /// `arg`'s skeleton as the rig reads it (`rig_for`); the output keeps `arg`'s offsets.
     pub fitted: Skeleton,
-    pub prepared: Prepared,
+    pub prepared: PreparedSkeleton,
 }
 
-pub fn read_target(path: &Path, model: &Frozen, device: &Device) -> anyhow::Result<Target> {
+pub fn read_target(path: &Path, model: &FrozenAutoencoder, device: &Device) -> anyhow::Result<Target> {
     let arg = read_skeleton(path)?;
     let (section, fitted) = rig_for(model, &arg.skeleton, || arg.record())?;
-    let prepared = Prepared::new(&fitted, section, names()?, device).with_context(|| arg.name.clone())?;
+    let prepared = PreparedSkeleton::new(&fitted, section, names()?, device).with_context(|| arg.name.clone())?;
     Ok(Target { arg, fitted, prepared })
 }
 
@@ -113,7 +113,7 @@ pub fn latents_npy(latents: &Latents) -> anyhow::Result<Vec<u8>> {
 /// Decode onto the target, `frame_time` seconds per frame, as the motion file `output` names
 /// (BVH, or glTF by its extension; `stdout` says which on stdout).
 pub fn decode_file(
-    model: &Frozen,
+    model: &FrozenAutoencoder,
     latents: &Latents,
     target: &Target,
     frame_time: f64,

@@ -9,7 +9,7 @@
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
 use crate::io::npy::{self, NpyArray};
 use crate::motion::Motion;
-use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, IkOptions, Placement, RestSource};
+use crate::repr::anytop::{self, RigOptions, AnyTopRig, AnyTopStats, IkOptions, Placement, RestSource};
 use crate::repr::{m2m, Features};
 use crate::skeleton::{topology, Skeleton};
 use crate::{bvh, gltf, io};
@@ -292,7 +292,7 @@ impl SkeletonArg {
             return Ok(section.clone());
         }
         let (rest, rest_source) = self.own_rest();
-        let options = AnyTopOptions { rest_source, ..AnyTopOptions::default() };
+        let options = RigOptions { rest_source, ..RigOptions::default() };
         AnyTopSection::new(&self.skeleton, &rest, &options).with_context(|| format!("{}: cannot build an AnyTop rig", self.name))
     }
 }

@@ -5,7 +5,7 @@ use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions, Loaded};
 use crate::cli::CommonOpts;
 use crate::correspond as correspondence;
-use crate::diffusion::checkpoint::{self, Frozen};
+use crate::diffusion::checkpoint::{self, FrozenDenoiser};
 use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, monotonic_matches, Match};
 use crate::dift::{self, DiftFeatures, DiftOptions};
 use crate::io::{self, npy};
@@ -250,7 +250,7 @@ fn same_skeleton(a: &crate::skeleton::Skeleton, b: &crate::skeleton::Skeleton) -
 }
 
 /// DIFT features of one loaded motion.
-fn features_of(model: &Frozen, m: &Loaded, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
+fn features_of(model: &FrozenDenoiser, m: &Loaded, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
     let prepared = dift::prepare(&model.info, &m.skeleton, &m.motion, &m.name)?;
     let schedule = model.info.schedule();
     dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, device).with_context(|| m.name.clone())

@@ -27,7 +27,7 @@ use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
 use crate::io;
 use crate::io::npy;
 use crate::motion::Motion;
-use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource};
+use crate::repr::anytop::{self, RigOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource};
 use crate::repr::{m2m, Features};
 use crate::skeleton::{lookup, topology, Skeleton};
 use anyhow::{anyhow, bail, Context};
@@ -681,8 +681,8 @@ fn record_of(arg: &SkeletonArg, rest_pose: Option<&Clip>, args: &Args, want_stat
 }
 
 /// The override flags as rig options, joint names resolved on `skeleton` (from `file`).
-fn anytop_options(args: &Args, skeleton: &Skeleton, file: &str, rest_source: RestSource) -> anyhow::Result<AnyTopOptions> {
-    let mut options = AnyTopOptions { rest_source, ..AnyTopOptions::default() };
+fn anytop_options(args: &Args, skeleton: &Skeleton, file: &str, rest_source: RestSource) -> anyhow::Result<RigOptions> {
+    let mut options = RigOptions { rest_source, ..RigOptions::default() };
     if let Some(names) = &args.face_joints {
         let j = joint_indices("--face-joints", names, skeleton, file)?;
         let Ok(four) = <[usize; 4]>::try_from(j) else { bail!("--face-joints takes four joint names, R_HIP,L_HIP,R_SHOULDER,L_SHOULDER; got {}", names.len()) };

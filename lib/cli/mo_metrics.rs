@@ -1,6 +1,6 @@
 //! `mo-metrics`: the evaluation metrics of AnyTop, Motion2Motion and SATA, and physical
 //! plausibility for any motion. This file only loads motion (BVH or NPY + skeleton, through
-//! `cli::load`), turns it into `metrics::Clip`s with our FK, calls `lib/metrics`, and prints
+//! `cli::load`), turns it into `metrics::WorldClip`s with our FK, calls `lib/metrics`, and prints
 //! JSON (every number named, units in a `units` table) or a table for humans.
 //! Definitions and deviations: docs/metrics.md.
 
@@ -14,8 +14,8 @@ use crate::metrics::fid::{fid, FidOptions};
 use crate::metrics::generation::{self, GenerationOptions, PointClip};
 use crate::metrics::movement;
 use crate::metrics::physics::{Ground, PhysicsOptions};
-use crate::metrics::{geometric, kinetic, physics, reconstruction, transfer, Clip};
-use crate::repr::anytop::AnyTopOptions;
+use crate::metrics::{geometric, kinetic, physics, reconstruction, transfer, WorldClip};
+use crate::repr::anytop::RigOptions;
 use anyhow::{bail, Context};
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
@@ -326,8 +326,8 @@ fn load_one(args: &Args, path: &Path) -> anyhow::Result<Loaded> {
 }
 
 /// A loaded motion as world positions, with a defined error for non-finite values.
-fn clip_of(l: &Loaded) -> anyhow::Result<Clip> {
-    let clip = Clip::from_motion(&l.skeleton, &l.motion);
+fn clip_of(l: &Loaded) -> anyhow::Result<WorldClip> {
+    let clip = WorldClip::from_motion(&l.skeleton, &l.motion);
     if let Some((f, j)) = clip.first_non_finite() {
         bail!("{}: non-finite position at frame {f}, joint {j} '{}'", l.name, l.skeleton.joints[j].name);
     }
@@ -431,7 +431,7 @@ fn run_transfer(
         bail!("{} and {} share no joint names: give --binding", src.name, target.name);
     }
     let src_clip = clip_of(&src)?;
-    let clips = results.iter().map(clip_of).collect::<anyhow::Result<Vec<Clip>>>()?;
+    let clips = results.iter().map(clip_of).collect::<anyhow::Result<Vec<WorldClip>>>()?;
     let mut per_result = Vec::new();
     for (l, c) in results.iter().zip(&clips) {
         let freq = transfer::frequency_alignment(&src_clip, c, &pairs).with_context(|| l.name.clone())?;
@@ -469,14 +469,14 @@ fn run_transfer(
                 );
             }
         }
-        let ex_clips = ex.iter().map(clip_of).collect::<anyhow::Result<Vec<Clip>>>()?;
+        let ex_clips = ex.iter().map(clip_of).collect::<anyhow::Result<Vec<WorldClip>>>()?;
         let (ex_sets, result_sets) = (windows(&ex_clips, fid_window), windows(&clips, fid_window));
-        let kin = |cs: &[Clip]| -> anyhow::Result<Vec<Vec<f64>>> { cs.iter().map(|c| kinetic::kinetic_features(c).context("kinetic features")).collect() };
+        let kin = |cs: &[WorldClip]| -> anyhow::Result<Vec<Vec<f64>>> { cs.iter().map(|c| kinetic::kinetic_features(c).context("kinetic features")).collect() };
         m.insert("fid_kinetic".into(), fid_value(&kin(&ex_sets)?, &kin(&result_sets)?)?);
         let fid_g = match geometric::human_roles(&clips[0]) {
             Ok(roles) => {
                 let opts = geometric::GeometricOptions::default();
-                let g = |cs: &[Clip]| -> anyhow::Result<Vec<Vec<f64>>> { cs.iter().map(|c| Ok(geometric::geometric_features(c, &roles, &opts)?)).collect() };
+                let g = |cs: &[WorldClip]| -> anyhow::Result<Vec<Vec<f64>>> { cs.iter().map(|c| Ok(geometric::geometric_features(c, &roles, &opts)?)).collect() };
                 fid_value(&g(&ex_sets)?, &g(&result_sets)?)?
             }
             Err(why) => json!({ "not_applicable": format!("no human roles on the target skeleton: {why}") }),
@@ -500,7 +500,7 @@ fn run_transfer(
 
 /// Clips cut into consecutive windows of `len` frames (the remainder dropped); `len` 0 keeps
 /// whole clips.
-fn windows(clips: &[Clip], len: usize) -> Vec<Clip> {
+fn windows(clips: &[WorldClip], len: usize) -> Vec<WorldClip> {
     if len == 0 {
         return clips.to_vec();
     }
@@ -553,7 +553,7 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
     // (--skeleton), else one built on the first ground-truth clip as AnyTop would.
     let section = match &args.skeleton {
         Some(p) => read_skeleton(p)?.record()?,
-        None => AnyTopSection::new(&first.skeleton, &first.motion.first_frames(2), &AnyTopOptions::default())
+        None => AnyTopSection::new(&first.skeleton, &first.motion.first_frames(2), &RigOptions::default())
             .with_context(|| format!("{}: cannot build an AnyTop rig", first.name))?,
     };
     let points = |ls: &[Loaded]| -> anyhow::Result<Vec<PointClip>> {
@@ -594,7 +594,7 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
 /// clips: the clips left out one at a time, their static mean pose and random crops (at
 /// least as many as the samples, two per clip) as long as the samples.
 fn movement_report(gt: &[Loaded], gen: &[Loaded], gt_points: &[PointClip], gen_points: &[PointClip], seed: u64) -> anyhow::Result<Value> {
-    let world = |ls: &[Loaded]| -> anyhow::Result<Vec<Clip>> { ls.iter().map(clip_of).collect() };
+    let world = |ls: &[Loaded]| -> anyhow::Result<Vec<WorldClip>> { ls.iter().map(clip_of).collect() };
     let (gt_world, gen_world) = (world(gt)?, world(gen)?);
     let reference = movement::Reference::new(&gt_world, gt_points, &movement::MovementOptions::default()).context("movement metrics")?;
     let frames = gen_world.iter().map(|c| c.frames).max().unwrap_or(120);

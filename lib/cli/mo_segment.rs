@@ -195,7 +195,7 @@ pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>
 }
 
 /// `--features dift`: DIFT features averaged over joints, one row per AnyTop feature frame.
-pub fn dift_features(model: &checkpoint::Frozen, input: &Input, opts: &DiftOptions) -> anyhow::Result<Vec<Vec<f64>>> {
+pub fn dift_features(model: &checkpoint::FrozenDenoiser, input: &Input, opts: &DiftOptions) -> anyhow::Result<Vec<Vec<f64>>> {
     let Some((skeleton, section)) = &input.skeleton else {
         bail!("{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input", input.name);
     };

@@ -27,7 +27,7 @@ use crate::augment::{self, RemoveAmount};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::motion::Motion;
-use crate::repr::anytop::{self, AnyTopOptions, AnyTopStats, RestSource};
+use crate::repr::anytop::{self, RigOptions, AnyTopStats, RestSource};
 use crate::repr::Features;
 use crate::rng::SplitMix64;
 use crate::skeleton::{topology, Skeleton};
@@ -198,7 +198,7 @@ fn prepare<'a>(
     let (rest_name, rest_motion) = rest;
     let source =
         if anytop::names_tpose(rest_name) { RestSource::TPose { file: rest_name.to_string() } } else { RestSource::FirstClip { file: rest_name.to_string() } };
-    let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
+    let options = RigOptions { rest_source: source, ..RigOptions::default() };
     let section = AnyTopSection::new(&skeleton, &rest_motion.first_frames(2), &options)
         .map_err(|e| DataError::Clip { clip: rest_name.to_string(), why: e.to_string() })?;
     let mut features = Vec::new();

@@ -233,7 +233,7 @@ pub enum Provenance {
 
 /// Choices for building a rig.
 #[derive(Clone, Debug, PartialEq)]
-pub struct AnyTopOptions {
+pub struct RigOptions {
     /// `[r_hip, l_hip, r_shoulder, l_shoulder]` instead of the automatic choice.
     pub face_joints: Option<[usize; 4]>,
     /// `[front, back]` for a body-axis facing instead of the automatic choice (ignored when
@@ -245,9 +245,9 @@ pub struct AnyTopOptions {
     pub rest_source: RestSource,
 }
 
-impl Default for AnyTopOptions {
+impl Default for RigOptions {
     fn default() -> Self {
-        AnyTopOptions { face_joints: None, body_axis: None, feet: None, rest_source: RestSource::Unrecorded }
+        RigOptions { face_joints: None, body_axis: None, feet: None, rest_source: RestSource::Unrecorded }
     }
 }
 

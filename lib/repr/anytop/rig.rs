@@ -18,7 +18,7 @@
 //! faces along its body: front and back are the ends of the skeleton's longest path (by bone
 //! length), front being the end nearer the head (else away from the tail, else nearer the root).
 
-use super::{heading_of, yaw_to_front, AnyTopError, AnyTopOptions, Facing, Provenance, RestSource, HUMANML_MEAN_BONE_LENGTH};
+use super::{heading_of, yaw_to_front, AnyTopError, RigOptions, Facing, Provenance, RestSource, HUMANML_MEAN_BONE_LENGTH};
 use crate::motion::Motion;
 use crate::repr::Features;
 use crate::skeleton::names::{self, Side};
@@ -136,7 +136,7 @@ impl Prepared {
 impl AnyTopRig {
     /// Process a skeleton's rest clip: `rest`'s frame 0 is the rest pose; all its frames
     /// count for the ground height.
-    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &AnyTopOptions) -> Result<AnyTopRig, AnyTopError> {
+    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &RigOptions) -> Result<AnyTopRig, AnyTopError> {
         skeleton.validate()?;
         let n = skeleton.len();
         if rest.joints != n {
