@@ -2,11 +2,12 @@
 //! --method latent`: load the SATA model, encode a clip into per-frame latents, decode latents
 //! onto a skeleton.
 
-use crate::cli::load::{motion_file, read_skeleton, MotionFormat, SkeletonArg};
+use crate::cli::load::{motion_file, read_skeleton, MotionFormat};
+use crate::input::SkeletonFile;
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::io::{self, npy};
-use crate::motion::Motion;
+use crate::motion::{Clip, Motion};
 use crate::sata::checkpoint::{self, FrozenAutoencoder};
 use crate::sata::infer::{Latents, PreparedSkeleton};
 use crate::skeleton::Skeleton;
@@ -48,10 +49,7 @@ pub fn read_source(path: &Path, model: &FrozenAutoencoder, device: &Device) -> a
     if bytes.starts_with(b"\x93NUMPY") {
         bail!("{name}: expected a BVH clip to encode, found an NPY file (decode features first: mo-encode --decode)");
     }
-    let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
-    let skeleton = Skeleton::from_bvh(&parsed);
-    skeleton.validate().with_context(|| name.clone())?;
-    let motion = Motion::from_bvh(&parsed, &skeleton);
+    let Clip { skeleton, motion, .. } = crate::cli::load::clip_from_bytes(&bytes, &name, path)?;
     if motion.frames < 2 {
         bail!("{name}: {} frame(s); a clip needs at least 2 frames to encode (velocities need a next frame)", motion.frames);
     }
@@ -77,7 +75,7 @@ pub fn encode(model: &FrozenAutoencoder, clip: &SourceClip, device: &Device) -> 
 /// The skeleton to decode onto (`--skeleton`/`--to`: a document or a BVH) with its rig (the
 /// model's for a trained skeleton, else the document's or the BVH's first frame) and graph.
 pub struct Target {
-    pub arg: SkeletonArg,
+    pub arg: SkeletonFile,
     /// `arg`'s skeleton as the rig reads it (`rig_for`); the output keeps `arg`'s offsets.
     pub fitted: Skeleton,
     pub prepared: PreparedSkeleton,
@@ -85,7 +83,7 @@ pub struct Target {
 
 pub fn read_target(path: &Path, model: &FrozenAutoencoder, device: &Device) -> anyhow::Result<Target> {
     let arg = read_skeleton(path)?;
-    let (section, fitted) = rig_for(model, &arg.skeleton, || arg.record())?;
+    let (section, fitted) = rig_for(model, &arg.skeleton, || Ok(arg.record()?))?;
     let prepared = PreparedSkeleton::new(&fitted, section, names()?, device).with_context(|| arg.name.clone())?;
     Ok(Target { arg, fitted, prepared })
 }

@@ -2,7 +2,8 @@
 
 use crate::binding::auto;
 use crate::cli::bounds;
-use crate::cli::load::{expand_inputs, load_motions, LoadOptions, Loaded};
+use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
+use crate::motion::Clip;
 use crate::cli::CommonOpts;
 use crate::correspond as correspondence;
 use crate::diffusion::checkpoint::{self, FrozenDenoiser};
@@ -250,7 +251,7 @@ fn same_skeleton(a: &crate::skeleton::Skeleton, b: &crate::skeleton::Skeleton) -
 }
 
 /// DIFT features of one loaded motion.
-fn features_of(model: &FrozenDenoiser, m: &Loaded, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
+fn features_of(model: &FrozenDenoiser, m: &Clip, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
     let prepared = dift::prepare(&model.info, &m.skeleton, &m.motion, &m.name)?;
     let schedule = model.info.schedule();
     dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, device).with_context(|| m.name.clone())
@@ -272,7 +273,7 @@ struct JointRow {
     one_to_one: Option<bool>,
 }
 
-fn joint_row(m: &Match, reference: &Loaded, target: &Loaded) -> JointRow {
+fn joint_row(m: &Match, reference: &Clip, target: &Clip) -> JointRow {
     JointRow {
         target: target.skeleton.joints[m.target].name.clone(),
         target_index: m.target,

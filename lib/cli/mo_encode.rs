@@ -20,7 +20,8 @@
 //! atomically, and a failed write removes the outputs of the call already written, so an
 //! error never leaves a partial output.
 
-use crate::cli::load::{is_dash, read_skeleton, split_samples, Decoder, SkeletonArg};
+use crate::cli::load::{is_dash, read_skeleton, split_samples, FeatureDecoder};
+use crate::input::SkeletonFile;
 pub use crate::cli::load::{load_skeleton, DecodeFrom, MotionFormat};
 use crate::cli::CommonOpts;
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
@@ -648,7 +649,7 @@ fn refuse_terminal(output: Option<&Path>) -> anyhow::Result<()> {
 /// on frame 0 of `rest_pose` when given, else of the BVH, else (a document without motion) on
 /// the OFFSET pose. A built record's statistics come from the BVH's motion, computed only when
 /// `want_stats` (they cost encoding the whole file).
-fn record_of(arg: &SkeletonArg, rest_pose: Option<&Clip>, args: &Args, want_stats: bool) -> anyhow::Result<AnyTopSection> {
+fn record_of(arg: &SkeletonFile, rest_pose: Option<&Clip>, args: &Args, want_stats: bool) -> anyhow::Result<AnyTopSection> {
     if let Some(section) = &arg.document.anytop {
         let fixed = [
             (rest_pose.is_some(), "--rest-pose"),
@@ -750,10 +751,10 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     let bytes = io::read_input(&input).with_context(|| format!("cannot read {name}"))?;
     let array = npy::from_bytes(&bytes, &name)?;
     drop(bytes);
-    let (samples, batch) = split_samples(array, &name)?;
+    let (samples, batch) = split_samples(array, &name).map_err(anyhow::Error::msg)?;
 
     let decoder = match args.repr {
-        Repr::M2m => Decoder::M2m,
+        Repr::M2m => FeatureDecoder::M2m,
         Repr::Anytop => {
             let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?;
             let section = record_of(&arg, rest_pose.as_ref(), args, args.normalised)?;
@@ -772,7 +773,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
             if args.common.verbose {
                 eprintln!("mo-encode: rig: {}", describe_rig(&section.rig, skeleton));
             }
-            Decoder::AnyTop { rig: Box::new(section.rig), stats, placements, from: args.from.unwrap_or(DecodeFrom::Rotations) }
+            FeatureDecoder::AnyTop { rig: Box::new(section.rig), stats, placements, from: args.from.unwrap_or(DecodeFrom::Rotations).into() }
         }
     };
 

@@ -6,7 +6,8 @@
 
 use crate::binding::Binding;
 use crate::cli::bounds;
-use crate::cli::load::{expand_inputs, load_motions, read_skeleton, DecodeFrom, LoadOptions, Loaded};
+use crate::cli::load::{expand_inputs, load_motions, read_skeleton, DecodeFrom, LoadOptions};
+use crate::motion::Clip;
 use crate::cli::CommonOpts;
 use crate::document::AnyTopSection;
 use crate::io;
@@ -307,7 +308,7 @@ fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -
     Ok(PhysicsOptions { contact_height, contact_speed, ground: ground.ground() })
 }
 
-fn load(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<Vec<Loaded>> {
+fn load(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<Vec<Clip>> {
     let files = expand_inputs(inputs)?;
     let options = LoadOptions { skeleton: args.skeleton.as_deref(), from: Some(args.from) };
     let loaded = load_motions(&files, &options)?;
@@ -317,7 +318,7 @@ fn load(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<Vec<Loaded>> {
     Ok(loaded)
 }
 
-fn load_one(args: &Args, path: &Path) -> anyhow::Result<Loaded> {
+fn load_one(args: &Args, path: &Path) -> anyhow::Result<Clip> {
     let mut loaded = load(args, &[path.to_path_buf()])?;
     if loaded.len() != 1 {
         bail!("{}: expected one motion, found {} (an NPY batch?)", io::display_name(path), loaded.len());
@@ -326,7 +327,7 @@ fn load_one(args: &Args, path: &Path) -> anyhow::Result<Loaded> {
 }
 
 /// A loaded motion as world positions, with a defined error for non-finite values.
-fn clip_of(l: &Loaded) -> anyhow::Result<WorldClip> {
+fn clip_of(l: &Clip) -> anyhow::Result<WorldClip> {
     let clip = WorldClip::from_motion(&l.skeleton, &l.motion);
     if let Some((f, j)) = clip.first_non_finite() {
         bail!("{}: non-finite position at frame {f}, joint {j} '{}'", l.name, l.skeleton.joints[j].name);
@@ -535,7 +536,7 @@ fn fid_value(real: &[Vec<f64>], generated: &[Vec<f64>]) -> anyhow::Result<Value>
 }
 
 /// Joints of the target whose normalised name matches a source joint's.
-fn same_name_pairs(src: &Loaded, tgt: &Loaded) -> Vec<(usize, usize)> {
+fn same_name_pairs(src: &Clip, tgt: &Clip) -> Vec<(usize, usize)> {
     use crate::skeleton::lookup::find_joint;
     (0..src.skeleton.len()).filter_map(|i| find_joint(&tgt.skeleton, &src.skeleton.joints[i].name).ok().map(|j| (i, j))).collect()
 }
@@ -556,7 +557,7 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
         None => AnyTopSection::new(&first.skeleton, &first.motion.first_frames(2), &RigOptions::default())
             .with_context(|| format!("{}: cannot build an AnyTop rig", first.name))?,
     };
-    let points = |ls: &[Loaded]| -> anyhow::Result<Vec<PointClip>> {
+    let points = |ls: &[Clip]| -> anyhow::Result<Vec<PointClip>> {
         use rayon::prelude::*;
         ls.par_iter().map(|l| point_clip(&section, l)).collect()
     };
@@ -593,8 +594,8 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
 /// The movement metrics (`metrics::movement`) of the samples and of baselines made from the
 /// clips: the clips left out one at a time, their static mean pose and random crops (at
 /// least as many as the samples, two per clip) as long as the samples.
-fn movement_report(gt: &[Loaded], gen: &[Loaded], gt_points: &[PointClip], gen_points: &[PointClip], seed: u64) -> anyhow::Result<Value> {
-    let world = |ls: &[Loaded]| -> anyhow::Result<Vec<WorldClip>> { ls.iter().map(clip_of).collect() };
+fn movement_report(gt: &[Clip], gen: &[Clip], gt_points: &[PointClip], gen_points: &[PointClip], seed: u64) -> anyhow::Result<Value> {
+    let world = |ls: &[Clip]| -> anyhow::Result<Vec<WorldClip>> { ls.iter().map(clip_of).collect() };
     let (gt_world, gen_world) = (world(gt)?, world(gen)?);
     let reference = movement::Reference::new(&gt_world, gt_points, &movement::MovementOptions::default()).context("movement metrics")?;
     let frames = gen_world.iter().map(|c| c.frames).max().unwrap_or(120);
@@ -647,7 +648,7 @@ fn run_aggregate(paths: &[PathBuf]) -> anyhow::Result<Value> {
 
 /// AnyTop's evaluation features of one clip: joints 1..J-1, dims 0..3 of the 13-D features
 /// (root-relative x, z in the facing frame; y absolute), with y minus the root height.
-fn point_clip(section: &AnyTopSection, l: &Loaded) -> anyhow::Result<PointClip> {
+fn point_clip(section: &AnyTopSection, l: &Clip) -> anyhow::Result<PointClip> {
     if l.motion.frames < 2 {
         bail!("{}: {} frame(s): generation metrics need clips of at least two frames", l.name, l.motion.frames);
     }

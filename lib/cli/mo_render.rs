@@ -3,7 +3,8 @@
 //! the sheet, GIF and HTML renderers. Every picture is drawn in memory before any file is
 //! written, so a bad input or option never leaves a partial or a stale-mixed set of outputs.
 
-use crate::cli::load::{expand_inputs, is_dash, load_motions, DecodeFrom, LoadOptions, Loaded};
+use crate::cli::load::{expand_inputs, is_dash, load_motions, DecodeFrom, LoadOptions};
+use crate::motion::Clip;
 use crate::cli::CommonOpts;
 use crate::io;
 use crate::render::camera::Framing;
@@ -214,7 +215,7 @@ fn kind_of_extension(p: &Path) -> Option<Kind> {
 }
 
 /// The first drawn frame and the tracks.
-fn tracks(loaded: &[Loaded], range: Option<(Option<usize>, Option<usize>)>) -> anyhow::Result<(usize, Vec<Track>)> {
+fn tracks(loaded: &[Clip], range: Option<(Option<usize>, Option<usize>)>) -> anyhow::Result<(usize, Vec<Track>)> {
     let start = range.and_then(|r| r.0).unwrap_or(0);
     let mut out = Vec::with_capacity(loaded.len());
     for l in loaded {

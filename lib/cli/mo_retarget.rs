@@ -6,7 +6,8 @@
 use crate::binding::auto;
 use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips, BvhClip, MotionFormat};
+use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips, MotionFormat};
+use crate::motion::Clip;
 use crate::cli::CommonOpts;
 use crate::io::{self, npy};
 use crate::motion::Motion;
@@ -238,8 +239,6 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     }
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
-
-type Clip = BvhClip;
 
 fn read_clip(path: &Path) -> anyhow::Result<Clip> {
     read_bvh_clip(path, "mo-retarget")

@@ -328,13 +328,15 @@ fn read_reference(
 ) -> anyhow::Result<Reference> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read the reference {name}"))?;
-    let parsed = crate::cli::load::parse_motion(&bytes, &name, path).with_context(|| format!("the reference {name}"))?;
-    let own = crate::skeleton::Skeleton::from_bvh(&parsed);
-    own.validate().with_context(|| name.clone())?;
-    if let Some(diff) = skeleton.first_difference(&own) {
+    // Parse errors say it is the reference; a bad skeleton's message names the file already.
+    let clip = crate::cli::load::clip_from_bytes(&bytes, &name, path).map_err(|e| match e {
+        e @ crate::motion::ClipError::Skeleton { .. } => anyhow::Error::new(e),
+        e => anyhow::Error::new(e).context(format!("the reference {name}")),
+    })?;
+    if let Some(diff) = skeleton.first_difference(&clip.skeleton) {
         bail!("the reference {name} is not on the skeleton of {skeleton_name}: {diff}");
     }
-    let motion = crate::motion::Motion::from_bvh(&parsed, &own);
+    let motion = clip.motion;
     if motion.frames < 2 {
         bail!("the reference {name} has {} frame(s); AnyTop features need at least 2", motion.frames);
     }

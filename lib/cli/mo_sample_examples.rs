@@ -5,7 +5,8 @@
 
 use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton, BvhClip};
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
+use crate::motion::Clip;
 use crate::diffusion::edit;
 use crate::genmm::{self, Keep, Settings};
 use crate::io::{self, npy};
@@ -109,7 +110,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 /// `--reference`: a clip of the examples' skeleton at their frame rate.
-fn read_reference(path: &std::path::Path, first: &BvhClip) -> anyhow::Result<BvhClip> {
+fn read_reference(path: &std::path::Path, first: &Clip) -> anyhow::Result<Clip> {
     let r = read_bvh_clip(path, "mo-sample --reference")?;
     if let Some(why) = first.skeleton.first_difference(&r.skeleton) {
         bail!("the reference {} is not on the skeleton of the example clips ({}): {why}", r.name, first.name);
@@ -132,7 +133,7 @@ fn read_reference(path: &std::path::Path, first: &BvhClip) -> anyhow::Result<Bvh
 
 /// What `--keep-frames` and `--keep-joints` keep: frames must exist in both the output and the
 /// reference; joints are kept over every output frame the reference has.
-fn keep<'a>(args: &Args, r: &'a BvhClip, frames: usize) -> anyhow::Result<Keep<'a>> {
+fn keep<'a>(args: &Args, r: &'a Clip, frames: usize) -> anyhow::Result<Keep<'a>> {
     let known = frames.min(r.motion.frames);
     let mut kept_frames = vec![false; frames];
     if let Some(text) = &args.keep_frames {
@@ -156,7 +157,7 @@ fn keep<'a>(args: &Args, r: &'a BvhClip, frames: usize) -> anyhow::Result<Keep<'
 }
 
 /// `--report`: the synthesis of every sample, one JSON line.
-fn report(clips: &[BvhClip], generated: &[genmm::Generated], time: std::time::Duration) -> String {
+fn report(clips: &[Clip], generated: &[genmm::Generated], time: std::time::Duration) -> String {
     let samples: Vec<serde_json::Value> = generated
         .iter()
         .map(|g| {

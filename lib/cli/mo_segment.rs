@@ -11,7 +11,7 @@ use crate::diffusion::checkpoint;
 use crate::dift::{self, DiftOptions};
 use crate::document::AnyTopSection;
 use crate::io::{self, npy};
-use crate::motion::Motion;
+use crate::motion::{Clip, Motion};
 use crate::repr::anytop::FEATURE_DIMS;
 use crate::repr::Features as ReprFeatures;
 use crate::segment::{self, SegmentOptions, Segmentation};
@@ -271,11 +271,8 @@ fn load(args: &Args) -> anyhow::Result<Input> {
         None => None,
     };
     if !npy::looks_like_npy(&args.input, &bytes) {
-        let parsed = crate::cli::load::parse_motion(&bytes, &name, &args.input)?;
+        let Clip { skeleton: own, motion, .. } = crate::cli::load::clip_from_bytes(&bytes, &name, &args.input)?;
         drop(bytes);
-        let own = Skeleton::from_bvh(&parsed);
-        own.validate().with_context(|| name.clone())?;
-        let motion = Motion::from_bvh(&parsed, &own);
         return match skeleton {
             // The skeleton's own record, so the features are those mo-encode makes with it.
             Some(arg) => {
@@ -288,7 +285,7 @@ fn load(args: &Args) -> anyhow::Result<Input> {
             None => Input::from_motion(name, own, motion),
         };
     }
-    let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name)?;
+    let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name).map_err(anyhow::Error::msg)?;
     if batch {
         bail!("{name}: a batch of {} samples; mo-segment takes one motion (a [frames, joints, 13] array)", samples.len());
     }

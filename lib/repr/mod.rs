@@ -6,6 +6,7 @@
 //! motion; `anytop`: AnyTop's 13-D per-joint features).
 
 pub mod anytop;
+pub mod batch;
 pub mod m2m;
 pub mod smooth;
 /// A `[frames, joints, dims]` float32 tensor, row-major (dims fastest).

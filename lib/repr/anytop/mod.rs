@@ -149,12 +149,8 @@ pub const DIMS_ROTATION: std::ops::Range<usize> = 3..9;
 pub const DIMS_VELOCITY: std::ops::Range<usize> = 9..12;
 pub const DIM_CONTACT: usize = 12;
 
-/// AnyTop's T-pose rule: a clip whose file name (not its directories) contains "tpos", in
-/// any case, holds the rest pose.
-pub fn names_tpose(path: &str) -> bool {
-    let file = path.rsplit(['/', '\\']).next().unwrap_or(path);
-    file.to_lowercase().contains("tpos")
-}
+/// AnyTop's T-pose rule lives with the clip files it looks at.
+pub use crate::motion::clip::names_tpose;
 
 /// How a clip's facing direction is measured from joint positions.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
