@@ -13,6 +13,7 @@ pub mod kinetic;
 pub mod movement;
 pub mod physics;
 pub mod reconstruction;
+pub mod report;
 pub mod transfer;
 
 use glam::DVec3;
