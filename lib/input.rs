@@ -13,7 +13,7 @@ use crate::io::npy::{self, NpyArray, NpyError};
 use crate::io::{self};
 use crate::motion::clip::{self, Clip, ClipError};
 use crate::motion::Motion;
-use crate::repr::anytop::{self, AnyTopError, RestSource, RigOptions};
+use crate::repr::anytop::{self, AnyTopError, AnyTopStats, NamedOverrides, RestSource, RigOptions};
 use crate::repr::batch::{split_samples, FeatureDecoder, PoseFrom};
 use crate::repr::m2m;
 use crate::skeleton::{topology, Skeleton, SkeletonError};
@@ -46,6 +46,12 @@ pub enum InputError {
         name: String,
         #[source]
         source: SkeletonError,
+    },
+    #[error("{name}: statistics of its motion")]
+    Stats {
+        name: String,
+        #[source]
+        source: AnyTopError,
     },
     #[error("{name}: cannot build an AnyTop rig")]
     Rig {
@@ -133,6 +139,53 @@ impl SkeletonFile {
         let (rest, rest_source) = self.own_rest();
         let options = RigOptions { rest_source, ..RigOptions::default() };
         AnyTopSection::new(&self.skeleton, &rest, &options).map_err(|source| InputError::Rig { name: self.name.clone(), source })
+    }
+}
+
+impl SkeletonFile {
+    /// The AnyTop record this skeleton stands for, the same way when encoding and decoding:
+    /// the document's own record (then no override may be given: it fixes the rig); else one
+    /// built with the overrides as `skel-info` builds it, on frame 0 of `rest_pose` when given,
+    /// else of the motion file, else (a document without motion) on the OFFSET pose. A built
+    /// record's statistics come from the file's motion, computed only when `want_stats` (they
+    /// cost encoding the whole file).
+    pub fn record_with(&self, rest_pose: Option<&Clip>, overrides: &NamedOverrides, want_stats: bool) -> Result<AnyTopSection, InputError> {
+        if let Some(section) = &self.document.anytop {
+            let flag = if rest_pose.is_some() { Some("--rest-pose") } else { overrides.first_given() };
+            if let Some(flag) = flag {
+                return Err(invalid(format!(
+                    "{flag}: the AnyTop record of {} fixes the rig (rest pose, facing, feet); to build another, give --skeleton a BVH or a document without one (skel-info --no-anytop)",
+                    self.name
+                )));
+            }
+            return Ok(section.clone());
+        }
+        let (rest, source) = match rest_pose {
+            Some(clip) => {
+                same_skeleton(&self.name, &self.skeleton, &clip.name, &clip.skeleton)?;
+                (clip.motion.first_frames(2), RestSource::Explicit { file: clip.name.clone() })
+            }
+            None => self.own_rest(),
+        };
+        let options = overrides.resolve(&self.skeleton, &self.name, source).map_err(invalid)?;
+        let rig_error = |source| InputError::Rig { name: self.name.clone(), source };
+        let mut section = AnyTopSection::new(&self.skeleton, &rest, &options).map_err(rig_error)?;
+        if let Some(motion) = self.motion.as_ref().filter(|m| want_stats && m.frames >= 2) {
+            let stats_error = |source| InputError::Stats { name: self.name.clone(), source };
+            let own = section.rig.encode(&self.skeleton, motion).map_err(stats_error)?;
+            section.stats = Some(AnyTopStats::compute([&own.features]).map_err(stats_error)?);
+        }
+        Ok(section)
+    }
+}
+
+/// AnyTop encodes one skeleton per call: the same joint names and parents.
+pub fn same_skeleton(a_name: &str, a: &Skeleton, b_name: &str, b: &Skeleton) -> Result<(), InputError> {
+    match a.first_difference(b) {
+        Some(why) => Err(invalid(format!(
+            "{a_name} and {b_name} have different skeletons ({why}): AnyTop encodes one skeleton per call, so encode them separately"
+        ))),
+        None => Ok(()),
     }
 }
 

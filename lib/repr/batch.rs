@@ -127,3 +127,35 @@ pub fn split_samples(array: NpyArray, name: &str) -> Result<(Vec<Features>, bool
     }
 }
 
+
+/// Features of clips (`names`, in the same order) that stack into one NPY batch: one shape
+/// for all, else which two differ.
+pub fn check_stackable(names: &[&str], features: &[Features]) -> Result<(), String> {
+    let first = &features[0];
+    for (name, f) in names.iter().zip(features).skip(1) {
+        if f.shape() != first.shape() {
+            return Err(format!(
+                "cannot stack {} {:?} and {name} {:?}: a batch needs the same frames and joints (encode them separately, or cut the clips to one length)",
+                names[0],
+                first.shape(),
+                f.shape()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every value finite, else where the first one is not: float32 features hold what a motion's
+/// f64 numbers became, and 1e300 is inf there.
+pub fn check_finite<'a>(names: &[&str], skeletons: impl IntoIterator<Item = &'a Skeleton>, features: &[Features]) -> Result<(), String> {
+    for ((name, skeleton), f) in names.iter().zip(skeletons).zip(features) {
+        if let Some((frame, joint, dim)) = f.first_non_finite() {
+            let value = f.at(frame, joint)[dim];
+            let joint_name = skeleton.joints.get(joint).map_or("?", |j| j.name.as_str());
+            return Err(format!(
+                "{name}: encodes to {value} at feature frame {frame}, joint {joint} '{joint_name}', dim {dim}: the motion holds numbers too large for float32 features"
+            ));
+        }
+    }
+    Ok(())
+}

@@ -115,11 +115,14 @@
 mod decode;
 mod encode;
 mod ik;
+pub mod named;
+pub mod placements;
 mod plant;
 mod rig;
 mod stats;
 
 pub use ik::IkOptions;
+pub use named::NamedOverrides;
 pub use plant::plant_feet;
 pub use rig::AnyTopRig;
 pub use stats::AnyTopStats;
