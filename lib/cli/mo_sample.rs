@@ -2,14 +2,14 @@
 //! clips of it without a model (`--examples`, in `mo_sample_examples`).
 
 use crate::cli::load::read_skeleton;
-use crate::cli::CommonOpts;
+use crate::cli::{output, CommonOpts};
 use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit::{self, KeepMask};
 use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
 use crate::diffusion::Sampler;
-use crate::io::{self, npy};
-use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
+use crate::io;
+use crate::repr::anytop::{AnyTopRig, IkOptions, Placement};
 use crate::repr::smooth::lambda_for_cutoff;
 use crate::repr::Features;
 use anyhow::{bail, Context};
@@ -199,10 +199,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     crate::nn::keep_freed_memory();
     let count = args.samples as usize;
-    let outputs: Option<Vec<PathBuf>> = match &args.bvh {
-        Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
-        None => None,
-    };
+    let outputs = args.bvh.as_deref().map(|p| output::numbered(p, count)).transpose()?;
     let dash = PathBuf::from("-");
     let arg = read_skeleton(args.skeleton.as_ref().or(args.skeleton_option.as_ref()).or(args.reference.as_ref()).unwrap_or(&dash))?;
     let skeleton = &arg.skeleton;
@@ -258,15 +255,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler, seed: args.common.seed };
     let started = std::time::Instant::now();
     let mut samples = match (&reference, &mask) {
-        (Some(r), Some(mask)) => {
-            // Frames past the reference's end are generated; their reference values are unused.
-            let mut padded = r.features.clone();
-            if padded.frames < frames {
-                padded.data.resize(frames * padded.joints * padded.dims, 0.0);
-                padded.frames = frames;
-            }
-            edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &padded, mask, &device)?
-        }
+        (Some(r), Some(mask)) => edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &r.features.padded_to(frames), mask, &device)?,
         _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
     };
     let fixed = mask.as_ref().map(|m| m.keep.as_slice());
@@ -277,32 +266,37 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {
         eprintln!("{}", seam_report(&section.rig, skeleton, r, mask, &samples)?);
     }
-    if args.common.verbose {
-        eprintln!("mo-sample: {count} x {frames} frames in {:.2} s", started.elapsed().as_secs_f64());
-    }
+    args.common.say("mo-sample").info(format_args!("{count} x {frames} frames in {:.2} s", started.elapsed().as_secs_f64()));
 
+    // An edit stands where its reference stood, so kept frames land on the reference's.
+    let placement = reference.as_ref().map_or_else(|| section.rig.rest_placement(), |r| r.placement);
+    write_samples(args, outputs, &samples, &section.rig, skeleton, &placement)
+}
+
+/// The samples as BVH files (`--bvh PATTERN`, all or none) or one NPY batch.
+fn write_samples(
+    args: &Args,
+    outputs: Option<Vec<PathBuf>>,
+    samples: &[Features],
+    rig: &AnyTopRig,
+    skeleton: &crate::skeleton::Skeleton,
+    placement: &Placement,
+) -> anyhow::Result<()> {
     match outputs {
         Some(paths) => {
-            // An edit stands where its reference stood, so kept frames land on the reference's.
-            let placement = reference.as_ref().map_or_else(|| section.rig.rest_placement(), |r| r.placement);
-            let mut texts = Vec::with_capacity(count);
-            for (i, f) in samples.iter().enumerate() {
-                let motion = section.rig.decode_ik(skeleton, f, &placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
-                texts.push(crate::cli::load::motion_file(skeleton, &motion, Some(&paths[i]), crate::cli::load::MotionFormat::Bvh)?);
+            let mut files = Vec::with_capacity(paths.len());
+            for (i, (f, path)) in samples.iter().zip(paths).enumerate() {
+                let motion = rig.decode_ik(skeleton, f, placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
+                let bytes = crate::cli::load::motion_file(skeleton, &motion, Some(&path), crate::cli::load::MotionFormat::Bvh)?;
+                files.push((Some(path), bytes));
             }
-            // All samples or none.
-            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_slice())).collect::<Vec<_>>())?;
+            output::write_all(&files)
         }
         None => {
-            io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
-            let shape = [count, frames, skeleton.len(), FEATURE_DIMS];
-            let parts: Vec<&[f32]> = samples.iter().map(|f| f.data.as_slice()).collect();
-            let mut bytes = Vec::new();
-            npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-            io::write_output(args.common.output.as_deref(), &bytes)?;
+            output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
+            Ok(io::write_output(args.common.output.as_deref(), &output::features_npy(samples, true)?)?)
         }
     }
-    Ok(())
 }
 
 /// The smoother's weight for `--smooth HZ` at `fps`; `None` for 0 (raw output).

@@ -4,24 +4,20 @@
 //! writes BVH on the examples' skeleton or Motion2Motion features, all outputs or none.
 
 use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
-use crate::cli::bounds;
+use crate::cli::{bounds, output};
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
 use crate::motion::Clip;
 use crate::diffusion::edit;
 use crate::genmm::{self, Keep, Settings};
-use crate::io::{self, npy};
+use crate::io;
 use crate::repr::m2m;
 use anyhow::{bail, Context};
-use std::path::PathBuf;
 use std::time::Instant;
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let count = args.samples as usize;
-    let outputs: Option<Vec<PathBuf>> = match &args.bvh {
-        Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
-        None => None,
-    };
+    let outputs = args.bvh.as_deref().map(|p| output::numbered(p, count)).transpose()?;
     let skeleton_path = args.skeleton.as_ref().or(args.skeleton_option.as_ref());
     let dashes = args.examples.iter().chain(skeleton_path).chain(args.reference.as_ref()).filter(|p| is_dash(p)).count();
     if dashes > 1 {
@@ -85,22 +81,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     match outputs {
         Some(paths) => {
-            let texts = generated
+            let files = generated
                 .iter()
-                .zip(&paths)
-                .map(|(g, p)| crate::cli::load::motion_file(skeleton, &g.motion, Some(p), crate::cli::load::MotionFormat::Bvh))
-                .collect::<anyhow::Result<Vec<Vec<u8>>>>()?;
-            // All samples or none.
-            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_slice())).collect::<Vec<_>>())?;
+                .zip(paths)
+                .map(|(g, p)| Ok((Some(p.clone()), crate::cli::load::motion_file(skeleton, &g.motion, Some(&p), crate::cli::load::MotionFormat::Bvh)?)))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            output::write_all(&files)?;
         }
         None => {
-            io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
+            output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
             let features: Vec<_> = generated.iter().map(|g| m2m::encode(&g.motion)).collect();
-            let shape = [count, frames, skeleton.len(), m2m::DIMS];
-            let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
-            let mut bytes = Vec::new();
-            npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-            io::write_output(args.common.output.as_deref(), &bytes)?;
+            io::write_output(args.common.output.as_deref(), &output::features_npy(&features, true)?)?;
         }
     }
     if args.common.verbose {

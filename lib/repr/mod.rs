@@ -27,6 +27,17 @@ impl Features {
         [self.frames, self.joints, self.dims]
     }
 
+    /// At least `frames` long: frames past the end are zeros (for an edit's reference, whose
+    /// values past its end are generated and never read).
+    pub fn padded_to(&self, frames: usize) -> Features {
+        let mut padded = self.clone();
+        if padded.frames < frames {
+            padded.data.resize(frames * padded.joints * padded.dims, 0.0);
+            padded.frames = frames;
+        }
+        padded
+    }
+
     /// The feature vector of one joint at one frame.
     pub fn at(&self, frame: usize, joint: usize) -> &[f32] {
         let i = (frame * self.joints + joint) * self.dims;
