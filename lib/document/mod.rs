@@ -7,6 +7,8 @@
 //! Later versions add optional fields (feature statistics, the rest-pose feature row);
 //! readers ignore fields they do not know.
 
+mod text;
+
 use crate::bvh::Bvh;
 use crate::bvh::Channel;
 use crate::motion::Motion;
