@@ -23,7 +23,7 @@
 
 mod common;
 
-use menagerie::segment::input::{dift_features, raw_features, segment_input, window_frames, Input, InputError};
+use menagerie::segment::input::{dift_features, raw_features, segment_input, window_frames, Input, SegmentInputError};
 use menagerie::diffusion::checkpoint;
 use menagerie::dift::DiftOptions;
 use menagerie::motion::Motion;
@@ -35,7 +35,7 @@ use menagerie::synth::{actions, training_clip, Action};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-type Provider<'a> = &'a dyn Fn(&Input) -> Result<Vec<Vec<f64>>, InputError>;
+type Provider<'a> = &'a dyn Fn(&Input) -> Result<Vec<Vec<f64>>, SegmentInputError>;
 
 struct Case {
     input: Input,

@@ -278,8 +278,8 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         let latents = super::latent::read_latents(&input)?;
         let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
         let target = super::latent::read_target(skeleton, &model, &device)?;
-        super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.arg.name, &target.arg.skeleton, args.common.quiet)?;
-        let frame_time = target.arg.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
+        super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.file.name, &target.file.skeleton, args.common.quiet)?;
+        let frame_time = target.file.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
         super::latent::decode_file(&model, &latents, &target, frame_time, &device, args.common.output.as_deref(), MotionFormat::Bvh)?
     };
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)

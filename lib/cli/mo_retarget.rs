@@ -220,7 +220,7 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     let source = super::latent::read_source(&args.source, &model, &device)?;
     let target = super::latent::read_target(&target_path, &model, &device)?;
     let known = super::ood::Known::latent(args.model.as_deref(), &model.rigs)?;
-    for (name, skeleton) in [(&source.name, &source.skeleton), (&target.arg.name, &target.arg.skeleton)] {
+    for (name, skeleton) in [(&source.name, &source.skeleton), (&target.file.name, &target.file.skeleton)] {
         known.warn("mo-retarget", name, skeleton, args.common.quiet)?;
     }
     let latents = super::latent::encode(&model, &source, &device)?;
@@ -230,8 +230,8 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
             "mo-retarget: latent: {} ({} joints) -> {} ({} joints), {} frames, latent {} per frame, {:.2} s",
             source.name,
             source.skeleton.len(),
-            target.arg.name,
-            target.arg.skeleton.len(),
+            target.file.name,
+            target.file.skeleton.len(),
             latents.frames,
             latents.dims,
             started.elapsed().as_secs_f64()

@@ -15,7 +15,7 @@ use crate::skeleton::Skeleton;
 
 /// Why a motion could not be prepared or segmented; every message names the file.
 #[derive(Debug, thiserror::Error)]
-pub enum InputError {
+pub enum SegmentInputError {
     #[error("{name}: cannot build an AnyTop rig")]
     Rig {
         name: String,
@@ -62,20 +62,20 @@ impl Input {
     /// A motion with a rig built on its own first two frames: AnyTop's rule for a clip without
     /// a T-pose file, the rig `mo-encode` builds for a single input, so `mo-encode clip.bvh |
     /// mo-segment` and `mo-segment clip.bvh` see the same features.
-    pub fn from_motion(name: String, skeleton: Skeleton, motion: Motion) -> Result<Input, InputError> {
+    pub fn from_motion(name: String, skeleton: Skeleton, motion: Motion) -> Result<Input, SegmentInputError> {
         if motion.frames < 2 {
-            return Err(InputError::Invalid(format!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames)));
+            return Err(SegmentInputError::Invalid(format!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames)));
         }
-        let section = AnyTopSection::of_clip(&skeleton, &motion, &name).map_err(|source| InputError::Rig { name: name.clone(), source })?;
+        let section = AnyTopSection::of_clip(&skeleton, &motion, &name).map_err(|source| SegmentInputError::Rig { name: name.clone(), source })?;
         Input::with_record(name, skeleton, motion, section)
     }
 
     /// A motion encoded with a given AnyTop record (a skeleton document's).
-    pub fn with_record(name: String, skeleton: Skeleton, motion: Motion, section: AnyTopSection) -> Result<Input, InputError> {
+    pub fn with_record(name: String, skeleton: Skeleton, motion: Motion, section: AnyTopSection) -> Result<Input, SegmentInputError> {
         if motion.frames < 2 {
-            return Err(InputError::Invalid(format!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames)));
+            return Err(SegmentInputError::Invalid(format!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames)));
         }
-        let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| InputError::Invalid(format!("{name}: {e}")))?;
+        let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| SegmentInputError::Invalid(format!("{name}: {e}")))?;
         let frame_time = usable_frame_time(motion.frame_time);
         Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)) })
     }
@@ -97,14 +97,14 @@ pub fn raw_features(input: &Input) -> Vec<Vec<f64>> {
 }
 
 /// `--features dift`: DIFT features averaged over joints, one row per AnyTop feature frame.
-pub fn dift_features(model: &FrozenDenoiser, input: &Input, opts: &DiftOptions) -> Result<Vec<Vec<f64>>, InputError> {
+pub fn dift_features(model: &FrozenDenoiser, input: &Input, opts: &DiftOptions) -> Result<Vec<Vec<f64>>, SegmentInputError> {
     let Some((skeleton, section)) = &input.skeleton else {
-        return Err(InputError::Invalid(format!("{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input", input.name)));
+        return Err(SegmentInputError::Invalid(format!("{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input", input.name)));
     };
-    let prepared = dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name).map_err(InputError::Dift)?;
+    let prepared = dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name).map_err(SegmentInputError::Dift)?;
     let schedule = model.info.schedule();
     let f = dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, &candle_core::Device::Cpu)
-        .map_err(|source| InputError::Within { name: input.name.clone(), source })?;
+        .map_err(|source| SegmentInputError::Within { name: input.name.clone(), source })?;
     Ok(f.per_frame().into_iter().map(|row| row.into_iter().map(f64::from).collect()).collect())
 }
 
@@ -119,11 +119,11 @@ pub fn window_frames(seconds: f64, frame_time: f64) -> usize {
 
 /// Segment `features` of `input` and return the result in BVH frames (labels extended to every
 /// frame of the motion, segments recomputed on them).
-pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOptions, seed: u64) -> Result<Segmentation, InputError> {
+pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOptions, seed: u64) -> Result<Segmentation, SegmentInputError> {
     if features.is_empty() {
-        return Err(InputError::Invalid(format!("{}: no feature frames to segment", input.name)));
+        return Err(SegmentInputError::Invalid(format!("{}: no feature frames to segment", input.name)));
     }
-    let mut s = super::segment(features, options, seed).map_err(|source| InputError::Segment { name: input.name.clone(), source })?;
+    let mut s = super::segment(features, options, seed).map_err(|source| SegmentInputError::Segment { name: input.name.clone(), source })?;
     s.labels = super::extend_labels(&s.labels, input.frames);
     s.segments = super::segments(&s.labels);
     Ok(s)
