@@ -264,7 +264,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         post.apply(f, &section.rig.feet, fixed);
     }
     if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {
-        eprintln!("{}", seam_report(&section.rig, skeleton, r, mask, &samples)?);
+        let report = edit::seam_report(&section.rig, skeleton, (&r.name, &r.features, &r.placement), mask, &samples)
+            .map_err(|e| anyhow::anyhow!("--report: {e}"))?;
+        eprintln!("{report}");
     }
     args.common.say("mo-sample").info(format_args!("{count} x {frames} frames in {:.2} s", started.elapsed().as_secs_f64()));
 
@@ -356,41 +358,4 @@ fn keep_mask(args: &Args, r: &Reference, skeleton: &crate::skeleton::Skeleton, f
         bail!("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate");
     }
     Ok(mask)
-}
-
-/// `--report`: seam jumps per sample against the reference clip's own distribution (one JSON line).
-fn seam_report(
-    rig: &crate::repr::anytop::AnyTopRig,
-    skeleton: &crate::skeleton::Skeleton,
-    r: &Reference,
-    mask: &KeepMask,
-    samples: &[Features],
-) -> anyhow::Result<String> {
-    let j = skeleton.len();
-    let positions = |f: &Features| rig.recover_positions(skeleton, f, &r.placement).map_err(|e| anyhow::anyhow!("--report: {e}"));
-    let reference = positions(&r.features)?;
-    let distribution = edit::jump_distribution([(reference.as_slice(), j)]);
-    let kept = mask.whole_frames();
-    let mut rows = Vec::with_capacity(samples.len());
-    for f in samples {
-        let p = positions(f)?;
-        let seams = edit::seam_jump(&p, j, &kept);
-        let max = seams.iter().map(|s| s.jump).fold(0.0, f64::max);
-        // The same number inside the generated stretch (boundaries between two generated
-        // frames): a seam as smooth as the model's own motion matches it.
-        let jumps = edit::boundary_jumps(&p, j);
-        let inside: Vec<f64> = (1..kept.len()).filter(|&b| !kept[b] && !kept[b - 1]).filter_map(|b| jumps.get(b - 1).copied()).collect();
-        let generated = edit::jump_distribution_of(inside);
-        rows.push(serde_json::json!({ "seams": seams, "max_seam_jump": max, "generated_jumps": generated }));
-    }
-    let report = serde_json::json!({
-        "report": "seam_jump",
-        "units": "BVH units per frame",
-        "reference": r.name,
-        "kept_frames": kept.iter().filter(|&&k| k).count(),
-        "kept_cells": mask.count(),
-        "reference_jumps": distribution,
-        "samples": rows,
-    });
-    Ok(report.to_string())
 }
