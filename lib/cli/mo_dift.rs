@@ -1,6 +1,6 @@
 //! `mo-dift`: diffusion features of a motion, and joint and frame correspondence from them.
 
-use crate::binding::auto;
+use crate::binding::{auto, clips};
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::motion::Clip;
@@ -224,17 +224,10 @@ fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
     }
     let (reference, target) = (&motions[0], &motions[1]);
     let text = if args.as_binding {
-        let choices = super::correspond::bind_auto(
-            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
-            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
-            args.bind_rate,
-        )?;
+        let choices = clips::bind_auto(reference, target, args.bind_rate)?;
         auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
     } else {
-        let scores = super::correspond::joint_scores(
-            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
-            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
-        )?;
+        let scores = clips::joint_scores(reference, target)?;
         let pairs = correspondence::assign(&scores);
         let rows: Vec<JointRow> = correspondence::per_target(&scores, &pairs)
             .into_iter()

@@ -416,11 +416,7 @@ fn read_inputs(args: &Args) -> anyhow::Result<(Clip, Vec<Clip>)> {
 /// document `--emit-binding` writes.
 fn binding_for(bind: &str, source: &Clip, first: &Clip, rate: Option<f64>) -> anyhow::Result<(JointMap, Binding)> {
     if bind == "auto" {
-        let choices = super::correspond::bind_auto(
-            &super::correspond::Side { name: &source.name, skeleton: &source.skeleton, motion: &source.motion },
-            &super::correspond::Side { name: &first.name, skeleton: &first.skeleton, motion: &first.motion },
-            rate,
-        )?;
+        let choices = crate::binding::clips::bind_auto(source, first, rate)?;
         let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
         return Ok((choices.iter().map(|c| (c.source, c.target)).collect(), binding));
     }

@@ -7,7 +7,6 @@
 //! Errors print as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
 pub mod bounds;
-pub mod correspond;
 pub mod docs;
 pub mod latent;
 pub mod load;
