@@ -20,7 +20,7 @@ use common::{bvh_files, median, time_runs, RUNS};
 use menagerie::bvh;
 use menagerie::io::npy;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{RigOptions, AnyTopRig, Encoded, IkOptions};
+use menagerie::repr::anytop::{AnyTopRig, Encoded, IkOptions, RigOptions};
 use menagerie::repr::{m2m, Features};
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;

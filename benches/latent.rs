@@ -24,7 +24,7 @@ use menagerie::metrics::physics::PhysicsOptions;
 use menagerie::metrics::reconstruction::{reconstruction, rotation_joints, ReconstructionReport, Rotations};
 use menagerie::metrics::WorldClip as MetricClip;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{RigOptions, Placement, RestSource};
+use menagerie::repr::anytop::{Placement, RestSource, RigOptions};
 use menagerie::repr::Features;
 use menagerie::rng::SplitMix64;
 use menagerie::sata::checkpoint::{self, FrozenAutoencoder};
@@ -123,8 +123,7 @@ fn encode(clip: &Clip, model: Option<&FrozenAutoencoder>, device: &Device) -> Op
             Some(known) => (known.section.clone(), known.fit(&clip.skeleton)),
             None => match &clip.rest {
                 Some(rest) => {
-                    let options =
-                        RigOptions { rest_source: RestSource::Explicit { file: format!("{} (augmented rest)", clip.name) }, ..RigOptions::default() };
+                    let options = RigOptions { rest_source: RestSource::Explicit { file: format!("{} (augmented rest)", clip.name) }, ..RigOptions::default() };
                     (AnyTopSection::new(&clip.skeleton, rest, &options)?, clip.skeleton.clone())
                 }
                 None => (AnyTopSection::of_clip(&clip.skeleton, &clip.motion, &clip.name)?, clip.skeleton.clone()),

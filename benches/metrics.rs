@@ -19,7 +19,7 @@ use menagerie::metrics::fid::{fid, FidOptions};
 use menagerie::metrics::generation::{generation_metrics, GenerationOptions, PointClip, PointFeatures};
 use menagerie::metrics::WorldClip;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{RigOptions, AnyTopRig};
+use menagerie::repr::anytop::{AnyTopRig, RigOptions};
 use menagerie::rng::SplitMix64;
 use menagerie::skeleton::{roles, Skeleton};
 use menagerie::synth::creature;

@@ -23,11 +23,11 @@
 
 mod common;
 
-use menagerie::segment::input::{dift_features, raw_features, segment_input, window_frames, Input, SegmentInputError};
 use menagerie::diffusion::checkpoint;
 use menagerie::dift::DiftOptions;
 use menagerie::motion::Motion;
 use menagerie::rng::SplitMix64;
+use menagerie::segment::input::{dift_features, raw_features, segment_input, window_frames, Input, SegmentInputError};
 use menagerie::segment::{boundaries, boundary_errors, SegmentOptions};
 use menagerie::skeleton::Skeleton;
 use menagerie::synth::creature_names;

@@ -112,9 +112,7 @@ impl SkeletonFile {
             Ok(SkeletonFile { tpose, name, skeleton, document, motion })
         } else {
             let start: String = body.iter().take(12).flat_map(|&b| std::ascii::escape_default(b)).map(char::from).collect();
-            Err(invalid(format!(
-                "{name}: not a skeleton: expected a skeleton document (JSON from skel-info), a BVH or a glTF file, found '{start}'"
-            )))
+            Err(invalid(format!("{name}: not a skeleton: expected a skeleton document (JSON from skel-info), a BVH or a glTF file, found '{start}'")))
         }
     }
 
@@ -182,9 +180,9 @@ impl SkeletonFile {
 /// AnyTop encodes one skeleton per call: the same joint names and parents.
 pub fn same_skeleton(a_name: &str, a: &Skeleton, b_name: &str, b: &Skeleton) -> Result<(), InputError> {
     match a.first_difference(b) {
-        Some(why) => Err(invalid(format!(
-            "{a_name} and {b_name} have different skeletons ({why}): AnyTop encodes one skeleton per call, so encode them separately"
-        ))),
+        Some(why) => {
+            Err(invalid(format!("{a_name} and {b_name} have different skeletons ({why}): AnyTop encodes one skeleton per call, so encode them separately")))
+        }
         None => Ok(()),
     }
 }
@@ -276,9 +274,8 @@ pub fn read_motions(inputs: &[PathBuf], options: &ReadMotions) -> Result<Vec<Cli
         let name = io::display_name(path);
         let bytes = io::read_input(path).map_err(|source| InputError::Io { message: format!("cannot read {name}"), source })?;
         if npy::looks_like_npy(path, &bytes) {
-            let path = options.skeleton.ok_or_else(|| {
-                invalid(format!("{name} is an NPY feature file: give --skeleton (a skeleton document or BVH) to decode it"))
-            })?;
+            let path =
+                options.skeleton.ok_or_else(|| invalid(format!("{name} is an NPY feature file: give --skeleton (a skeleton document or BVH) to decode it")))?;
             // Read once for all NPY inputs; the first failure is every caller's message.
             let file = skeleton.get_or_init(|| SkeletonFile::read(path, options.gltf).map_err(|e| full_message(&e)));
             let file = file.as_ref().map_err(|e| invalid(e.clone()))?;

@@ -151,4 +151,3 @@ pub fn read_bvh_clip(path: &Path, tool: &str) -> anyhow::Result<Clip> {
 pub fn read_example_clips(inputs: &[PathBuf], tool: &str, what: &str) -> anyhow::Result<Vec<Clip>> {
     Ok(input::read_example_clips(inputs, &gltf_options(), tool, what)?)
 }
-

@@ -3,13 +3,13 @@
 use crate::binding::{auto, clips};
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
-use crate::motion::Clip;
 use crate::cli::{output, CommonOpts};
 use crate::correspond as correspondence;
 use crate::diffusion::checkpoint::{self, FrozenDenoiser};
 use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, monotonic_matches, Match};
 use crate::dift::{self, DiftFeatures, DiftOptions};
 use crate::io::{self, npy};
+use crate::motion::Clip;
 use anyhow::{bail, Context};
 use candle_core::Device;
 use std::path::PathBuf;
@@ -185,11 +185,7 @@ fn comparison(args: &Args, motions: &[Clip], features: &[DiftFeatures], opts: &D
             let rate = args.bind_rate.unwrap_or(DIFT_BIND_RATE);
             let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, rate, auto::AutoOptions::default().min_pairs);
             if choices.is_empty() {
-                bail!(
-                    "{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind",
-                    reference.name,
-                    target.name
-                );
+                bail!("{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind", reference.name, target.name);
             }
             auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
         } else {

@@ -440,8 +440,8 @@ fn encoding_rig(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> 
         RestChoice::FirstClip => RestSource::FirstClip { file },
     };
     let options = overrides(args).resolve(&rest.skeleton, &rest.name, source).map_err(anyhow::Error::msg)?;
-    let section = AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options)
-        .with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
+    let section =
+        AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options).with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
     // The document describes the encoded clips (their frame time), with the rig.
     let document = SkeletonDocument::build(&first.skeleton, first_info, &first.name, topology::DEFAULT_DMAX);
     Ok((document, section, rest.name.clone()))

@@ -7,13 +7,13 @@
 use crate::binding::Binding;
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, read_skeleton, DecodeFrom, LoadOptions};
-use crate::motion::Clip;
 use crate::cli::CommonOpts;
 use crate::document::AnyTopSection;
 use crate::io;
 use crate::metrics::generation::GenerationOptions;
 use crate::metrics::physics::{Ground, PhysicsOptions};
 use crate::metrics::report;
+use crate::motion::Clip;
 use crate::repr::anytop::RigOptions;
 use anyhow::{bail, Context};
 use serde_json::{json, Value};
@@ -266,9 +266,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             run_generation(args, gt, generated, &opts)?
         }
     };
-    if args.common.verbose {
-        eprintln!("mo-metrics: done in {:.3} s", started.elapsed().as_secs_f64());
-    }
+    args.common.say("mo-metrics").info(format_args!("done in {:.3} s", started.elapsed().as_secs_f64()));
     let text = match args.format {
         Format::Json => serde_json::to_string_pretty(&report).context("building the JSON")? + "\n",
         Format::Table => report::table(&report),
@@ -337,9 +335,8 @@ fn run_reconstruction(args: &Args, reference: &Path, result: &Path, height: Opti
     // Features (and latents) of an F-frame clip describe F - 1 frames: the last one only gives
     // velocities. So every encode -> decode round trip is one frame short; compare what it has.
     if b.motion.frames + 1 == a.motion.frames {
-        if !args.common.quiet {
-            eprintln!("mo-metrics: note: {} has one frame fewer than {} (a decoded round trip); comparing its {} frames", b.name, a.name, b.motion.frames);
-        }
+        let note = format!("{} has one frame fewer than {} (a decoded round trip); comparing its {} frames", b.name, a.name, b.motion.frames);
+        args.common.say("mo-metrics").note(note);
         a.motion = a.motion.first_frames(b.motion.frames);
     }
     if a.motion.frames != b.motion.frames {

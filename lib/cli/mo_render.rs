@@ -250,9 +250,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     io::write_all(&pictures.iter().map(|(b, p, _)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?;
     for (bytes, path, kind) in &pictures {
         let target = path.as_ref().map_or("stdout".to_string(), |p| p.display().to_string());
-        if args.common.verbose {
-            eprintln!("mo-render: wrote {kind:?} ({} bytes, {} motion(s)) to {target}", bytes.len(), tracks.len());
-        }
+        args.common.say("mo-render").info(format_args!("wrote {kind:?} ({} bytes, {} motion(s)) to {target}", bytes.len(), tracks.len()));
     }
     Ok(())
 }

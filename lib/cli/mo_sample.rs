@@ -264,8 +264,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         post.apply(f, &section.rig.feet, fixed);
     }
     if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {
-        let report = edit::seam_report(&section.rig, skeleton, (&r.name, &r.features, &r.placement), mask, &samples)
-            .map_err(|e| anyhow::anyhow!("--report: {e}"))?;
+        let report =
+            edit::seam_report(&section.rig, skeleton, (&r.name, &r.features, &r.placement), mask, &samples).map_err(|e| anyhow::anyhow!("--report: {e}"))?;
         eprintln!("{report}");
     }
     args.common.say("mo-sample").info(format_args!("{count} x {frames} frames in {:.2} s", started.elapsed().as_secs_f64()));

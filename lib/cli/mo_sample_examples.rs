@@ -4,12 +4,12 @@
 //! writes BVH on the examples' skeleton or Motion2Motion features, all outputs or none.
 
 use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
-use crate::cli::{bounds, output};
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
-use crate::motion::Clip;
+use crate::cli::{bounds, output};
 use crate::diffusion::edit;
 use crate::genmm::{self, Keep, Settings};
 use crate::io;
+use crate::motion::Clip;
 use crate::repr::m2m;
 use anyhow::{bail, Context};
 use std::time::Instant;
@@ -66,16 +66,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.report {
         eprintln!("{}", report(&clips, &generated, generation));
     }
-    if args.common.verbose {
-        eprintln!("mo-sample: {count} x {frames} frames from {} example clip(s) in {:.3} s", clips.len(), generation.as_secs_f64());
-    }
+    let say = args.common.say("mo-sample");
+    say.info(format_args!("{count} x {frames} frames from {} example clip(s) in {:.3} s", clips.len(), generation.as_secs_f64()));
     if !args.common.quiet {
         let mut notes: Vec<&String> = generated.iter().flat_map(|g| &g.report.notes).collect();
         notes.dedup();
         notes.sort();
         notes.dedup();
         for note in notes {
-            eprintln!("mo-sample: note: {note}");
+            say.note(note);
         }
     }
 
@@ -94,9 +93,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             io::write_output(args.common.output.as_deref(), &output::features_npy(&features, true)?)?;
         }
     }
-    if args.common.verbose {
-        eprintln!("mo-sample: total {:.3} s", started.elapsed().as_secs_f64());
-    }
+    say.info(format_args!("total {:.3} s", started.elapsed().as_secs_f64()));
     Ok(())
 }
 

@@ -159,7 +159,6 @@ pub struct Args {
     pub common: CommonOpts,
 }
 
-/// A probability: a decimal in [0, 1] or a fraction `a/b`.
 /// A moving-average decay: a number in [0, 1) (1 would never move).
 fn parse_decay(text: &str) -> Result<f64, String> {
     let value: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number"))?;
@@ -170,6 +169,7 @@ fn parse_decay(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A probability: a decimal in [0, 1] or a fraction `a/b`.
 fn parse_probability(text: &str) -> Result<f64, String> {
     let value = match text.split_once('/') {
         Some((a, b)) => {
@@ -308,9 +308,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Arch::Anytop => train_anytop(args, &resolved, &device),
         Arch::Sata => train_sata(args, &resolved, &device),
     }?;
-    if !args.common.quiet {
-        eprintln!("mo-train: saved step {done} to {}", args.out.display());
-    }
+    say(args, &format!("saved step {done} to {}", args.out.display()));
     Ok(())
 }
 
@@ -340,10 +338,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
             say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
         }
         if let Some((old, new)) = resume.shift_changes(&opts) {
-            say(
-                args,
-                &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"),
-            );
+            say(args, &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
         }
         if let Some((old, new)) = resume.weighting_changes(&opts) {
             say(args, &format!("note: the checkpoint was trained with --loss-weighting {old}; it goes on learning under {new}"));

@@ -3,7 +3,6 @@
 use crate::cli::CommonOpts;
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
 use crate::motion::Motion;
-use crate::repr::anytop::{self, RestSource};
 use crate::skeleton::{topology, Skeleton};
 use crate::{bvh, io};
 use anyhow::Context;
@@ -110,25 +109,16 @@ fn anytop_section(
     quiet: bool,
 ) -> anyhow::Result<Option<AnyTopSection>> {
     let motion = Motion::from_bvh(parsed, skeleton);
-    let (rest, source) = match rest_pose {
-        Some((file, rest_skeleton, rest)) => {
-            let same = rest_skeleton.joints.len() == skeleton.joints.len()
-                && rest_skeleton.joints.iter().zip(&skeleton.joints).all(|(a, b)| a.name == b.name && a.parent == b.parent);
-            if !same {
-                anyhow::bail!("--rest-pose {file} has a different skeleton than {name}");
-            }
-            (rest.clone(), RestSource::Explicit { file: file.clone() })
+    if let Some((file, rest_skeleton, _)) = rest_pose {
+        let same = rest_skeleton.joints.len() == skeleton.joints.len()
+            && rest_skeleton.joints.iter().zip(&skeleton.joints).all(|(a, b)| a.name == b.name && a.parent == b.parent);
+        if !same {
+            anyhow::bail!("--rest-pose {file} has a different skeleton than {name}");
         }
-        None if parsed.frames > 0 => {
-            let file = name.to_string();
-            let source = if anytop::names_tpose(&file) { RestSource::TPose { file } } else { RestSource::FirstClip { file } };
-            (motion.first_frames(2), source)
-        }
-        None => (Motion::rest(skeleton), RestSource::Offsets),
-    };
+    }
     // A skeleton AnyTop cannot describe (a single joint, bones of zero length) is still a
     // skeleton: describe it without the record and say why.
-    match AnyTopSection::build(skeleton, &rest, source, &[&motion]) {
+    match AnyTopSection::of_file(skeleton, &motion, name, rest_pose.map(|(file, _, rest)| (file.as_str(), rest))) {
         Ok(section) => Ok(Some(section)),
         Err(e) => {
             if !quiet {

@@ -27,7 +27,7 @@ use crate::augment::{self, RemoveAmount};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::motion::Motion;
-use crate::repr::anytop::{self, RigOptions, AnyTopStats, RestSource};
+use crate::repr::anytop::{self, AnyTopStats, RestSource, RigOptions};
 use crate::repr::Features;
 use crate::rng::SplitMix64;
 use crate::skeleton::{topology, Skeleton};

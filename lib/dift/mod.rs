@@ -199,7 +199,13 @@ pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file
 
 /// `prepare` for a motion already encoded (physical AnyTop features) with a rig whose P_S is
 /// `rest_row`, e.g. an NPY from `mo-encode` and its skeleton document.
-pub fn prepare_encoded(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], mut features: Features, file: &str) -> Result<PreparedMotion, DiftError> {
+pub fn prepare_encoded(
+    info: &CheckpointInfo,
+    skeleton: &Skeleton,
+    rest_row: &[Vec<f32>],
+    mut features: Features,
+    file: &str,
+) -> Result<PreparedMotion, DiftError> {
     let measured = AnyTopStats::compute([&features]).map_err(DiftError::repr(file))?;
     let condition = SkeletonCondition::with_stats(info, skeleton, rest_row, measured, StatsSource::Measured)
         .map_err(|source| DiftError::Condition { file: file.to_string(), source })?;

@@ -12,7 +12,7 @@ mod text;
 use crate::bvh::Bvh;
 use crate::bvh::Channel;
 use crate::motion::Motion;
-use crate::repr::anytop::{AnyTopError, RigOptions, AnyTopRig, AnyTopStats, RestSource, FEATURE_DIMS};
+use crate::repr::anytop::{AnyTopError, AnyTopRig, AnyTopStats, RestSource, RigOptions, FEATURE_DIMS};
 use crate::skeleton::names::{self, Side};
 use crate::skeleton::roles::{self, FootRule};
 use crate::skeleton::{topology, Joint, Skeleton, Stats};
@@ -86,6 +86,23 @@ impl AnyTopSection {
     pub fn of_clip(skeleton: &Skeleton, motion: &Motion, file: &str) -> Result<AnyTopSection, AnyTopError> {
         let options = RigOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..RigOptions::default() };
         AnyTopSection::new(skeleton, &motion.first_frames(2), &options)
+    }
+
+    /// The record `skel-info` gives a motion file (`name`; its motion may have no frames): the
+    /// rest pose is frame 0 of `rest` when given (a file of the same skeleton and its motion),
+    /// else of the file itself (named like a T-pose or not: AnyTop's rule), else the OFFSET pose;
+    /// statistics over the file's motion.
+    pub fn of_file(skeleton: &Skeleton, motion: &Motion, name: &str, rest: Option<(&str, &Motion)>) -> Result<AnyTopSection, AnyTopError> {
+        let (rest, source) = match rest {
+            Some((file, rest)) => (rest.clone(), RestSource::Explicit { file: file.to_string() }),
+            None if motion.frames > 0 => {
+                let file = name.to_string();
+                let source = if crate::motion::clip::names_tpose(&file) { RestSource::TPose { file } } else { RestSource::FirstClip { file } };
+                (motion.first_frames(2), source)
+            }
+            None => (Motion::rest(skeleton), RestSource::Offsets),
+        };
+        AnyTopSection::build(skeleton, &rest, source, &[motion])
     }
 
     /// `new` with default options, plus statistics over `clips` (those with at least two frames).

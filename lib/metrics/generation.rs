@@ -17,7 +17,7 @@
 //!
 //! Definitions, units and deviations from the reference: `docs/metrics.md`.
 
-use super::{WorldClip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::repr::anytop::{Facing, HUMANML_MEAN_BONE_LENGTH};
 use crate::rng::SplitMix64;
 use glam::{DQuat, DVec3};

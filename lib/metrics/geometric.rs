@@ -12,7 +12,7 @@
 //! false instead of NaN.
 
 use super::physics::{check_clip, joint_name};
-use super::{WorldClip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::skeleton::names::{self, Side};
 use glam::DVec3;
 

@@ -8,7 +8,7 @@
 //! to f32); clips shorter than 3 frames are refused instead of giving zero energy expenditure.
 
 use super::physics::check_clip;
-use super::{WorldClip, MetricError};
+use super::{MetricError, WorldClip};
 use glam::DVec3;
 
 /// Half-width of the smoothing window, in frames (the reference's `sliding_window = 2`).

@@ -26,7 +26,7 @@
 
 use super::generation::PointClip;
 use super::physics::{contacts, Ground, PhysicsOptions};
-use super::{WorldClip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::rng::SplitMix64;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -493,7 +493,16 @@ mod tests {
                 [DVec3::Y, DVec3::new(x, 0.0, 0.0)]
             })
             .collect();
-        WorldClip { frames, joints: 2, fps: 30.0, positions, parents: vec![None, Some(0)], names: vec!["Hips".into(), "LeftFoot".into()], feet: vec![1], scale: 1.0 }
+        WorldClip {
+            frames,
+            joints: 2,
+            fps: 30.0,
+            positions,
+            parents: vec![None, Some(0)],
+            names: vec!["Hips".into(), "LeftFoot".into()],
+            feet: vec![1],
+            scale: 1.0,
+        }
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! dinosaur are judged alike; every distance is reported in clip units and divided by the
 //! scale (`Measure::normalised`).
 
-use super::{WorldClip, MetricError};
+use super::{MetricError, WorldClip};
 use glam::DVec3;
 use serde::ser::SerializeMap;
 

@@ -4,7 +4,7 @@
 //! `docs/metrics.md`.
 
 use super::physics::{self, check_clip, Maybe, Measure, PhysicsOptions};
-use super::{WorldClip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::skeleton::Skeleton;
 use glam::DQuat;
 

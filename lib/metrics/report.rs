@@ -165,12 +165,16 @@ pub fn transfer_report(t: &Transfer) -> Result<Value, ReportError> {
         }
         let ex_clips = ex.iter().map(world_clip).collect::<Result<Vec<WorldClip>, ReportError>>()?;
         let (ex_sets, result_sets) = (windows(&ex_clips, fid_window), windows(&clips, fid_window));
-        let kin = |cs: &[WorldClip]| -> Result<Vec<Vec<f64>>, ReportError> { cs.iter().map(|c| kinetic::kinetic_features(c).map_err(within("kinetic features"))).collect() };
+        let kin = |cs: &[WorldClip]| -> Result<Vec<Vec<f64>>, ReportError> {
+            cs.iter().map(|c| kinetic::kinetic_features(c).map_err(within("kinetic features"))).collect()
+        };
         m.insert("fid_kinetic".into(), fid_value(&kin(&ex_sets)?, &kin(&result_sets)?)?);
         let fid_g = match geometric::human_roles(&clips[0]) {
             Ok(roles) => {
                 let opts = geometric::GeometricOptions::default();
-                let g = |cs: &[WorldClip]| -> Result<Vec<Vec<f64>>, ReportError> { cs.iter().map(|c| Ok(geometric::geometric_features(c, &roles, &opts)?)).collect() };
+                let g = |cs: &[WorldClip]| -> Result<Vec<Vec<f64>>, ReportError> {
+                    cs.iter().map(|c| Ok(geometric::geometric_features(c, &roles, &opts)?)).collect()
+                };
                 fid_value(&g(&ex_sets)?, &g(&result_sets)?)?
             }
             Err(why) => json!({ "not_applicable": format!("no human roles on the target skeleton: {why}") }),

@@ -4,7 +4,7 @@
 //! ours; `docs/metrics.md` states each choice.
 
 use super::physics::{self, check_clip, Maybe, Measure, PhysicsOptions};
-use super::{WorldClip, MetricError};
+use super::{MetricError, WorldClip};
 use glam::DVec3;
 
 /// Frequency alignment: mean over joint pairs of the cosine similarity of the power spectral
@@ -140,7 +140,12 @@ fn subtree(clip: &WorldClip, j: usize) -> Vec<bool> {
 /// foot below the joint is in contact" (`physics::contacts`); result frame f is compared with
 /// source frame round(f x (source frames - 1) / (result frames - 1)), so clips of different
 /// lengths compare at the same phase. `NotApplicable` when no pair reaches feet on both sides.
-pub fn contact_consistency(source: &WorldClip, result: &WorldClip, pairs: &[(usize, usize)], opts: &PhysicsOptions) -> Result<Maybe<ContactConsistency>, MetricError> {
+pub fn contact_consistency(
+    source: &WorldClip,
+    result: &WorldClip,
+    pairs: &[(usize, usize)],
+    opts: &PhysicsOptions,
+) -> Result<Maybe<ContactConsistency>, MetricError> {
     check_clip(source, 2, "contact consistency (source)")?;
     check_clip(result, 2, "contact consistency (result)")?;
     check_pairs(source, result, pairs, "contact consistency")?;

@@ -16,11 +16,11 @@ pub mod labels;
 pub mod raster;
 pub mod sheet;
 
-use crate::motion::Motion;
 use crate::motion::Clip;
+use crate::motion::Motion;
 use crate::skeleton::{roles, Skeleton};
-use std::path::Path;
 use glam::{DVec3, Vec3};
+use std::path::Path;
 
 /// One motion, ready to draw.
 #[derive(Clone, Debug)]
@@ -145,7 +145,7 @@ impl View {
 
 impl Track {
     /// Tracks of clips, each cut to frames `range` (START:END, either open), titled by file name;
-        /// also the first drawn frame.
+    /// also the first drawn frame.
     pub fn from_clips(loaded: &[Clip], range: Option<(Option<usize>, Option<usize>)>) -> Result<(usize, Vec<Track>), String> {
         let start = range.and_then(|r| r.0).unwrap_or(0);
         let mut out = Vec::with_capacity(loaded.len());

@@ -111,9 +111,7 @@ fn check_anytop(features: &Features, skeleton: &Skeleton) -> Result<(), (String,
 /// Rank 3 -> one motion; rank 4 -> one per sample (`true`: the input was a batch).
 pub fn split_samples(array: NpyArray, name: &str) -> Result<(Vec<Features>, bool), String> {
     match array.shape.as_slice() {
-        shape if shape.len() >= 3 && shape[shape.len() - 3] == 0 => {
-            Err(format!("{name}: the features hold no frames (shape {shape:?})"))
-        }
+        shape if shape.len() >= 3 && shape[shape.len() - 3] == 0 => Err(format!("{name}: the features hold no frames (shape {shape:?})")),
         &[frames, joints, dims] => Ok((vec![Features { frames, joints, dims, data: array.data }], false)),
         &[n, frames, joints, dims] => {
             if n == 0 {
@@ -123,10 +121,11 @@ pub fn split_samples(array: NpyArray, name: &str) -> Result<(Vec<Features>, bool
             let samples = (0..n).map(|i| Features { frames, joints, dims, data: array.data[i * per..(i + 1) * per].to_vec() }).collect();
             Ok((samples, true))
         }
-        shape => Err(format!("{name}: expected a [frames, joints, dims] or [samples, frames, joints, dims] array, found shape {shape:?} (rank {})", shape.len())),
+        shape => {
+            Err(format!("{name}: expected a [frames, joints, dims] or [samples, frames, joints, dims] array, found shape {shape:?} (rank {})", shape.len()))
+        }
     }
 }
-
 
 /// Features of clips (`names`, in the same order) that stack into one NPY batch: one shape
 /// for all, else which two differ.

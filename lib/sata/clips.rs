@@ -6,9 +6,9 @@
 //! They are written here once, so that a library caller gets exactly what the tools do.
 
 use super::checkpoint::{self, FrozenAutoencoder};
-use crate::diffusion::checkpoint::CheckpointError;
 use super::infer::{Latents, PreparedSkeleton};
 use super::SataError;
+use crate::diffusion::checkpoint::CheckpointError;
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::input::{InputError, SkeletonFile};

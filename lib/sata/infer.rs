@@ -139,7 +139,14 @@ impl FrozenAutoencoder {
 
     /// A motion of `target` that the latents describe, placed where the target's rest pose
     /// stands, with `frame_time`.
-    pub fn decode_motion(&self, latents: &Latents, target: &Skeleton, prepared: &PreparedSkeleton, frame_time: f64, device: &Device) -> Result<Motion, SataError> {
+    pub fn decode_motion(
+        &self,
+        latents: &Latents,
+        target: &Skeleton,
+        prepared: &PreparedSkeleton,
+        frame_time: f64,
+        device: &Device,
+    ) -> Result<Motion, SataError> {
         let features = self.decode_latents(latents, &prepared.graph, device)?;
         let rig = &prepared.section.rig;
         let mut motion = rig.decode(target, &features, &rig.rest_placement())?;

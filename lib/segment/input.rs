@@ -64,7 +64,10 @@ impl Input {
     /// mo-segment` and `mo-segment clip.bvh` see the same features.
     pub fn from_motion(name: String, skeleton: Skeleton, motion: Motion) -> Result<Input, SegmentInputError> {
         if motion.frames < 2 {
-            return Err(SegmentInputError::Invalid(format!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames)));
+            return Err(SegmentInputError::Invalid(format!(
+                "{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)",
+                motion.frames
+            )));
         }
         let section = AnyTopSection::of_clip(&skeleton, &motion, &name).map_err(|source| SegmentInputError::Rig { name: name.clone(), source })?;
         Input::with_record(name, skeleton, motion, section)
@@ -73,7 +76,10 @@ impl Input {
     /// A motion encoded with a given AnyTop record (a skeleton document's).
     pub fn with_record(name: String, skeleton: Skeleton, motion: Motion, section: AnyTopSection) -> Result<Input, SegmentInputError> {
         if motion.frames < 2 {
-            return Err(SegmentInputError::Invalid(format!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames)));
+            return Err(SegmentInputError::Invalid(format!(
+                "{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)",
+                motion.frames
+            )));
         }
         let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| SegmentInputError::Invalid(format!("{name}: {e}")))?;
         let frame_time = usable_frame_time(motion.frame_time);
@@ -99,7 +105,10 @@ pub fn raw_features(input: &Input) -> Vec<Vec<f64>> {
 /// `--features dift`: DIFT features averaged over joints, one row per AnyTop feature frame.
 pub fn dift_features(model: &FrozenDenoiser, input: &Input, opts: &DiftOptions) -> Result<Vec<Vec<f64>>, SegmentInputError> {
     let Some((skeleton, section)) = &input.skeleton else {
-        return Err(SegmentInputError::Invalid(format!("{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input", input.name)));
+        return Err(SegmentInputError::Invalid(format!(
+            "{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input",
+            input.name
+        )));
     };
     let prepared = dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name).map_err(SegmentInputError::Dift)?;
     let schedule = model.info.schedule();
@@ -128,4 +137,3 @@ pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOpti
     s.segments = super::segments(&s.labels);
     Ok(s)
 }
-

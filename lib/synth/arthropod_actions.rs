@@ -9,7 +9,7 @@
 
 use super::arthropod::{centipede_body, crab_body, place_jointed_leg, spider_body, CentipedeBody, CrabBody, SpiderBody};
 use super::route::FootSpec;
-use super::training::{Action, TrainingClip, Job, Plan};
+use super::training::{Action, Job, Plan, TrainingClip};
 use super::*;
 
 fn scaled(gait: Gait, r: f64) -> Gait {

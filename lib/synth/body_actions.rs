@@ -10,7 +10,7 @@
 
 use super::bird::{bird_body, BirdBody};
 use super::route::FootSpec;
-use super::training::{Action, TrainingClip, Job, Plan};
+use super::training::{Action, Job, Plan, TrainingClip};
 use super::undulating::{fish_body, snake_body, FishBody, SnakeBody};
 use super::*;
 

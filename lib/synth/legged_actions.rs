@@ -8,7 +8,7 @@
 
 use super::legged::{biped_body, quad_training_body, BipedBody, QuadBody};
 use super::route::FootSpec;
-use super::training::{Action, TrainingClip, Job, Plan};
+use super::training::{Action, Job, Plan, TrainingClip};
 use super::*;
 
 /// Stride and lift scale with `r` (leg length over the example's), the period with its root.

@@ -5,7 +5,7 @@ use crate::common;
 
 use menagerie::bvh;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{RigOptions, AnyTopRig, AnyTopStats, Facing, IkOptions, Placement, RestSource, DIM_CONTACT, FEATURE_DIMS};
+use menagerie::repr::anytop::{AnyTopRig, AnyTopStats, Facing, IkOptions, Placement, RestSource, RigOptions, DIM_CONTACT, FEATURE_DIMS};
 use menagerie::repr::Features;
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;

@@ -7,7 +7,7 @@ use menagerie::bvh;
 use menagerie::metrics::geometric::{self, GeometricOptions};
 use menagerie::metrics::physics::{self, Maybe, PhysicsOptions};
 use menagerie::metrics::reconstruction::{self, Rotations};
-use menagerie::metrics::{kinetic, transfer, WorldClip, MetricError};
+use menagerie::metrics::{kinetic, transfer, MetricError, WorldClip};
 use menagerie::motion::Motion;
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;

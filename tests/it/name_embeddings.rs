@@ -198,4 +198,3 @@ fn malformed_tables_are_errors() {
     huge[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
     assert!(NameTable::from_bytes(&huge).is_err(), "header length past the end");
 }
-

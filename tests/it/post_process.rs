@@ -10,7 +10,7 @@ use menagerie::diffusion::sample::PostProcess;
 use menagerie::metrics::movement::energy;
 use menagerie::metrics::WorldClip;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{RigOptions, AnyTopRig, IkOptions};
+use menagerie::repr::anytop::{AnyTopRig, IkOptions, RigOptions};
 use menagerie::repr::smooth::lambda_for_cutoff;
 use menagerie::skeleton::Skeleton;
 use std::path::Path;

@@ -15,11 +15,8 @@ struct Entry<'a> {
 
 /// A JSON list, one clip per line, named by `files`.
 pub fn to_json<'a>(files: impl IntoIterator<Item = &'a str>, placements: &[Placement]) -> Result<String, serde_json::Error> {
-    let lines = files
-        .into_iter()
-        .zip(placements)
-        .map(|(file, placement)| serde_json::to_string(&Entry { file, placement }))
-        .collect::<Result<Vec<String>, _>>()?;
+    let lines =
+        files.into_iter().zip(placements).map(|(file, placement)| serde_json::to_string(&Entry { file, placement })).collect::<Result<Vec<String>, _>>()?;
     Ok(format!("[\n  {}\n]\n", lines.join(",\n  ")))
 }
 
@@ -39,9 +36,7 @@ pub fn from_json(bytes: &[u8], name: &str, samples: usize, npy_name: &str) -> Re
     let placements = match serde_json::from_value::<PlacementFile>(value) {
         Ok(PlacementFile::List(list)) => list,
         Ok(PlacementFile::One(one)) => vec![one],
-        Err(e) => {
-            return Err(format!("{name}: not a placement file (a JSON list of {{\"heading\", \"root_xz\"}} as mo-encode --placement writes): {e}"))
-        }
+        Err(e) => return Err(format!("{name}: not a placement file (a JSON list of {{\"heading\", \"root_xz\"}} as mo-encode --placement writes): {e}")),
     };
     if let Some(i) = placements.iter().position(|p| !(p.heading.is_finite() && p.root_xz.iter().all(|v| v.is_finite()))) {
         return Err(format!("{name}: placement {i} holds a non-finite number"));

@@ -18,7 +18,7 @@
 //! faces along its body: front and back are the ends of the skeleton's longest path (by bone
 //! length), front being the end nearer the head (else away from the tail, else nearer the root).
 
-use super::{heading_of, yaw_to_front, AnyTopError, RigOptions, Facing, Provenance, RestSource, HUMANML_MEAN_BONE_LENGTH};
+use super::{heading_of, yaw_to_front, AnyTopError, Facing, Provenance, RestSource, RigOptions, HUMANML_MEAN_BONE_LENGTH};
 use crate::motion::Motion;
 use crate::repr::Features;
 use crate::skeleton::names::{self, Side};
