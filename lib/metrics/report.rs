@@ -128,9 +128,9 @@ pub fn transfer_report(t: &Transfer) -> Result<Value, ReportError> {
     let clips = results.iter().map(world_clip).collect::<Result<Vec<WorldClip>, ReportError>>()?;
     let mut per_result = Vec::new();
     for (l, c) in results.iter().zip(&clips) {
-        let freq = transfer::frequency_alignment(&src_clip, c, &pairs).map_err(within(&l.name))?;
-        let contact = transfer::contact_consistency(&src_clip, c, &pairs, &PhysicsOptions::default()).map_err(within(&l.name))?;
-        let motion = transfer::motion_ratio(&src_clip, c, &pairs).map_err(within(&l.name))?;
+        let freq = transfer::frequency_alignment(&src_clip, c, pairs).map_err(within(&l.name))?;
+        let contact = transfer::contact_consistency(&src_clip, c, pairs, &PhysicsOptions::default()).map_err(within(&l.name))?;
+        let motion = transfer::motion_ratio(&src_clip, c, pairs).map_err(within(&l.name))?;
         per_result.push(json!({ "file": l.name, "frequency_alignment": freq, "contact_consistency": contact, "motion_ratio": motion }));
     }
     let mut out = json!({
@@ -246,7 +246,7 @@ pub fn generation_report(gt: &[Clip], gen: &[Clip], section: &AnyTopSection, opt
         use rayon::prelude::*;
         ls.par_iter().map(|l| point_clip(section, l)).collect()
     };
-    let (gt_points, gen_points) = (points(&gt)?, points(&gen)?);
+    let (gt_points, gen_points) = (points(gt)?, points(gen)?);
     let report = generation::generation_metrics(&gen_points, &gt_points, opts)?;
     let movement = movement_report(gt, gen, &gt_points, &gen_points, opts.seed)?;
     Ok(json!({

@@ -22,14 +22,15 @@ pub enum SegmentInputError {
         #[source]
         source: AnyTopError,
     },
+    // Boxed: a DIFT error is large, and every result here carries this type.
     #[error(transparent)]
-    Dift(DiftError),
+    Dift(Box<DiftError>),
     /// DIFT extraction failed on the named motion.
     #[error("{name}")]
     Within {
         name: String,
         #[source]
-        source: DiftError,
+        source: Box<DiftError>,
     },
     #[error("{name}: cannot segment")]
     Segment {
@@ -110,10 +111,11 @@ pub fn dift_features(model: &FrozenDenoiser, input: &Input, opts: &DiftOptions) 
             input.name
         )));
     };
-    let prepared = dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name).map_err(SegmentInputError::Dift)?;
+    let prepared =
+        dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name).map_err(|e| SegmentInputError::Dift(Box::new(e)))?;
     let schedule = model.info.schedule();
     let f = dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, &candle_core::Device::Cpu)
-        .map_err(|source| SegmentInputError::Within { name: input.name.clone(), source })?;
+        .map_err(|source| SegmentInputError::Within { name: input.name.clone(), source: Box::new(source) })?;
     Ok(f.per_frame().into_iter().map(|row| row.into_iter().map(f64::from).collect()).collect())
 }
 

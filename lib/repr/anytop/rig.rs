@@ -556,6 +556,26 @@ fn body_axis(skeleton: &Skeleton, parents: &[Option<usize>], children: &[Vec<usi
     Facing::BodyAxis { front, back }
 }
 
+impl AnyTopRig {
+    /// One line about the rig (`mo-encode -v`): where its rest pose came from, its facing, feet and scale.
+    pub fn describe(&self, skeleton: &Skeleton) -> String {
+        let rig = self;
+        let name = |j: usize| skeleton.joints.get(j).map_or("?", |x| x.name.as_str());
+        let how = |p: Provenance| if p == Provenance::Override { "given" } else { "automatic" };
+        let rest = match &rig.rest_source {
+            RestSource::TPose { file } => format!("rest pose frame 0 of {file} (T-pose)"),
+            RestSource::FirstClip { file } | RestSource::Explicit { file } => format!("rest pose frame 0 of {file}"),
+            RestSource::Offsets => "rest pose from the OFFSETs".to_string(),
+            RestSource::Unrecorded => "rest pose not recorded".to_string(),
+        };
+        let facing = match &rig.facing {
+            Facing::FaceJoints(f) => format!("face joints {}, {}, {}, {}", name(f[0]), name(f[1]), name(f[2]), name(f[3])),
+            Facing::BodyAxis { front, back } => format!("body axis {} -> {}", name(*back), name(*front)),
+        };
+        format!("{rest}; {facing} ({}); {} foot joint(s) ({}); scale {:.6}", how(rig.facing_source), rig.feet.len(), how(rig.feet_source), rig.scale_factor)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::mirror_key;
@@ -574,25 +594,5 @@ mod tests {
             assert_eq!(mirror_key(a), mirror_key(b), "{a} / {b}");
         }
         assert_ne!(mirror_key("DEF_BN_Leg_L_11"), mirror_key("DEF_BN_Leg_R_07"));
-    }
-}
-
-impl AnyTopRig {
-    /// One line about the rig (`mo-encode -v`): where its rest pose came from, its facing, feet and scale.
-    pub fn describe(&self, skeleton: &Skeleton) -> String {
-        let rig = self;
-        let name = |j: usize| skeleton.joints.get(j).map_or("?", |x| x.name.as_str());
-        let how = |p: Provenance| if p == Provenance::Override { "given" } else { "automatic" };
-        let rest = match &rig.rest_source {
-            RestSource::TPose { file } => format!("rest pose frame 0 of {file} (T-pose)"),
-            RestSource::FirstClip { file } | RestSource::Explicit { file } => format!("rest pose frame 0 of {file}"),
-            RestSource::Offsets => "rest pose from the OFFSETs".to_string(),
-            RestSource::Unrecorded => "rest pose not recorded".to_string(),
-        };
-        let facing = match &rig.facing {
-            Facing::FaceJoints(f) => format!("face joints {}, {}, {}, {}", name(f[0]), name(f[1]), name(f[2]), name(f[3])),
-            Facing::BodyAxis { front, back } => format!("body axis {} -> {}", name(*back), name(*front)),
-        };
-        format!("{rest}; {facing} ({}); {} foot joint(s) ({}); scale {:.6}", how(rig.facing_source), rig.feet.len(), how(rig.feet_source), rig.scale_factor)
     }
 }
