@@ -189,6 +189,15 @@ pub enum SamplerArg {
     Ddim,
 }
 
+impl SamplerArg {
+    fn sampler(self) -> Sampler {
+        match self {
+            SamplerArg::Ddpm => Sampler::Ddpm,
+            SamplerArg::Ddim => Sampler::Ddim,
+        }
+    }
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     if !args.examples.is_empty() {
@@ -232,27 +241,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // joint and frame.
     let tokens = count as u128 * frames as u128 * skeleton.len() as u128;
     crate::budget::check(&format!("{count} samples of {frames} frames on {} joints", skeleton.len()), tokens, loaded.info.config.width * 4 * 4)?;
-    let mask = match &reference {
-        Some(r) => Some(keep_mask(args, r, skeleton, frames)?),
-        None => None,
-    };
+    let mask = reference.as_ref().map(|r| keep_mask(args, r, skeleton, frames)).transpose()?;
 
     let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, section.stats.as_ref()).with_context(|| arg.name.clone())?;
     if condition.stats_source == StatsSource::Fallback && !args.common.quiet {
         eprintln!("mo-sample: {}: not a trained skeleton and no statistics in it: normalising by its rest pose and the trained skeletons' spreads", arg.name);
     }
     let cond = condition.condition();
-    let sampler = match args.sampler {
-        SamplerArg::Ddpm => Sampler::Ddpm,
-        SamplerArg::Ddim => Sampler::Ddim,
-    };
     let lambda = smoothing(args.smooth, fps)?;
     if !(args.blend.is_finite() && args.blend >= 0.0 && args.blend <= crate::cli::bounds::MAX_SECONDS) {
         bail!("--blend must be a duration in seconds (>= 0), found {}", args.blend);
     }
     let blend = (args.blend * fps).round() as usize;
     let schedule = loaded.info.schedule();
-    let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler, seed: args.common.seed };
+    let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler: args.sampler.sampler(), seed: args.common.seed };
     let started = std::time::Instant::now();
     let mut samples = match (&reference, &mask) {
         (Some(r), Some(mask)) => edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &r.features.padded_to(frames), mask, &device)?,

@@ -37,10 +37,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let frame_time = first.motion.frame_time;
     let fps = if frame_time > 0.0 { 1.0 / frame_time } else { 30.0 };
-    let reference = match &args.reference {
-        Some(path) => Some(read_reference(path, first)?),
-        None => None,
-    };
+    let reference = args.reference.as_deref().map(|path| read_reference(path, first)).transpose()?;
     let frames = match (args.seconds, args.frames, &reference) {
         (Some(s), _, _) => match bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
             n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
@@ -51,10 +48,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (None, None, None) => clips.iter().map(|c| c.motion.frames).max().unwrap_or(1),
     };
     crate::budget::check_motion(&format!("{count} samples of {frames} frames"), count.saturating_mul(frames), skeleton.len())?;
-    let keep = match &reference {
-        Some(r) => Some(keep(args, r, frames)?),
-        None => None,
-    };
+    let keep = reference.as_ref().map(|r| keep(args, r, frames)).transpose()?;
 
     let motions: Vec<crate::motion::Motion> = clips.iter().map(|c| c.motion.clone()).collect();
     let settings = Settings { frames: Some(frames), ..Settings::default() };
