@@ -26,12 +26,12 @@ use menagerie::augment::{self, RemoveAmount};
 use menagerie::bvh;
 use menagerie::correspond::describe::{describe, Limb, Roles};
 use menagerie::correspond::{self, Body, Evidence};
-use menagerie::diffusion::checkpoint::{self, Frozen};
+use menagerie::diffusion::checkpoint::{self, FrozenDenoiser};
 use menagerie::dift::correspond::{best_matches, cosine_matrix};
 use menagerie::dift::{self, eval, DiftOptions};
 use menagerie::document::AnyTopSection;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::AnyTopOptions;
+use menagerie::repr::anytop::RigOptions;
 use menagerie::rng::SplitMix64;
 use menagerie::skeleton::names::Side;
 use menagerie::skeleton::Skeleton;
@@ -64,7 +64,7 @@ fn first_in(dir: &Path) -> Option<Clip> {
 }
 
 fn rest(s: &Skeleton, m: &Motion) -> Option<Vec<glam::DVec3>> {
-    let section = AnyTopSection::new(s, &m.first_frames(2), &AnyTopOptions::default()).ok()?;
+    let section = AnyTopSection::new(s, &m.first_frames(2), &RigOptions::default()).ok()?;
     Some(section.rig.rest_positions(s))
 }
 
@@ -86,7 +86,7 @@ struct Score {
 }
 
 /// DIFT per-joint descriptors (the `mo-dift --joints` defaults: t 2, layer 0, 4 draws, centred).
-fn dift_rows(model: &Frozen, c: &Clip) -> Option<Vec<Vec<f32>>> {
+fn dift_rows(model: &FrozenDenoiser, c: &Clip) -> Option<Vec<Vec<f32>>> {
     let prepared = dift::prepare(&model.info, &c.skeleton, &c.motion, &c.name).ok()?;
     let f =
         dift::extract(&model.model, &model.info.schedule(), &prepared.condition.condition(), &prepared.features, &DiftOptions::SPATIAL, &Device::Cpu).ok()?;
@@ -94,7 +94,7 @@ fn dift_rows(model: &Frozen, c: &Clip) -> Option<Vec<Vec<f32>>> {
 }
 
 /// Score every method on reference `a` vs target `b` with `truth[target] = reference joint`.
-fn score_pair(model: Option<&Frozen>, a: &Clip, b: &Clip, truth: &[Option<usize>]) -> Option<Vec<Score>> {
+fn score_pair(model: Option<&FrozenDenoiser>, a: &Clip, b: &Clip, truth: &[Option<usize>]) -> Option<Vec<Score>> {
     let (ra, rb) = (rest(&a.skeleton, &a.motion)?, rest(&b.skeleton, &b.motion)?);
     let (ba, bb) = (Body { skeleton: &a.skeleton, rest: &ra }, Body { skeleton: &b.skeleton, rest: &rb });
     // The reference's own sides and limb pairs (names and rest pose) judge the confusions.

@@ -18,13 +18,13 @@ mod common;
 use candle_core::Device;
 use menagerie::augment::{self, RemoveAmount};
 use menagerie::bvh;
-use menagerie::diffusion::checkpoint::{self, Frozen};
+use menagerie::diffusion::checkpoint::{self, FrozenDenoiser};
 use menagerie::dift::correspond::{self, best_matches, cosine_matrix};
 use menagerie::dift::eval::{self, Accuracy};
 use menagerie::dift::{self, DiftOptions};
 use menagerie::document::AnyTopSection;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::AnyTopOptions;
+use menagerie::repr::anytop::RigOptions;
 use menagerie::rng::SplitMix64;
 use menagerie::skeleton::Skeleton;
 use std::collections::BTreeMap;
@@ -69,7 +69,7 @@ fn clips() -> Vec<Clip> {
 
 /// Per-joint rest positions facing +z (the AnyTop rig's natural rest pose).
 fn facing_rest(s: &Skeleton, m: &Motion) -> Option<Vec<glam::DVec3>> {
-    let section = AnyTopSection::new(s, &m.first_frames(2), &AnyTopOptions::default()).ok()?;
+    let section = AnyTopSection::new(s, &m.first_frames(2), &RigOptions::default()).ok()?;
     Some(section.rig.rest_positions(s))
 }
 
@@ -82,7 +82,7 @@ struct Extracted {
     seconds: f64,
 }
 
-fn extract_all(model: &Frozen, s: &Skeleton, m: &Motion, name: &str) -> anyhow::Result<Extracted> {
+fn extract_all(model: &FrozenDenoiser, s: &Skeleton, m: &Motion, name: &str) -> anyhow::Result<Extracted> {
     let prepared = dift::prepare(&model.info, s, m, name)?;
     let schedule = model.info.schedule();
     let cond = prepared.condition.condition();

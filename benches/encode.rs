@@ -20,7 +20,7 @@ use common::{bvh_files, median, time_runs, RUNS};
 use menagerie::bvh;
 use menagerie::io::npy;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig, Encoded, IkOptions};
+use menagerie::repr::anytop::{AnyTopRig, Encoded, IkOptions, RigOptions};
 use menagerie::repr::{m2m, Features};
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;
@@ -120,7 +120,7 @@ fn main() {
         let rigged: Vec<(&Clip, AnyTopRig, Encoded)> = clips
             .iter()
             .filter_map(|c| {
-                let rig = AnyTopRig::new(&c.skeleton, &c.motion.first_frames(1), &AnyTopOptions::default()).ok()?;
+                let rig = AnyTopRig::new(&c.skeleton, &c.motion.first_frames(1), &RigOptions::default()).ok()?;
                 let encoded = rig.encode(&c.skeleton, &c.motion).ok()?;
                 Some((c, rig, encoded))
             })

@@ -22,13 +22,13 @@ use menagerie::document::AnyTopSection;
 use menagerie::embed::NameTable;
 use menagerie::metrics::physics::PhysicsOptions;
 use menagerie::metrics::reconstruction::{reconstruction, rotation_joints, ReconstructionReport, Rotations};
-use menagerie::metrics::Clip as MetricClip;
+use menagerie::metrics::WorldClip as MetricClip;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{AnyTopOptions, Placement, RestSource};
+use menagerie::repr::anytop::{Placement, RestSource, RigOptions};
 use menagerie::repr::Features;
 use menagerie::rng::SplitMix64;
-use menagerie::sata::checkpoint::{self, Frozen};
-use menagerie::sata::infer::{Latents, Prepared};
+use menagerie::sata::checkpoint::{self, FrozenAutoencoder};
+use menagerie::sata::infer::{Latents, PreparedSkeleton};
 use menagerie::skeleton::Skeleton;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -94,7 +94,7 @@ fn sets() -> Vec<(String, Vec<Clip>)> {
     out
 }
 
-fn models(device: &Device) -> Vec<(String, Frozen)> {
+fn models(device: &Device) -> Vec<(String, FrozenAutoencoder)> {
     let spec = std::env::var("MENAGERIE_LATENT_MODELS").unwrap_or_else(|_| "builtin=".to_string());
     spec.split(',')
         .filter(|s| !s.is_empty())
@@ -108,7 +108,7 @@ fn models(device: &Device) -> Vec<(String, Frozen)> {
 
 /// A clip's features, placement and prepared graph.
 struct Encoded {
-    prepared: Prepared,
+    prepared: PreparedSkeleton,
     /// The clip's skeleton as the rig reads it (`KnownRig::fit`).
     skeleton: Skeleton,
     features: Features,
@@ -117,21 +117,20 @@ struct Encoded {
 
 /// A clip encoded for `model`: with the rig it was trained with when it knows the skeleton
 /// (as `mo-encode --latent` does), else the clip's own.
-fn encode(clip: &Clip, model: Option<&Frozen>, device: &Device) -> Option<Encoded> {
+fn encode(clip: &Clip, model: Option<&FrozenAutoencoder>, device: &Device) -> Option<Encoded> {
     let go = || -> anyhow::Result<Encoded> {
         let (section, skeleton) = match model.and_then(|m| m.rigs.find(&clip.skeleton)) {
             Some(known) => (known.section.clone(), known.fit(&clip.skeleton)),
             None => match &clip.rest {
                 Some(rest) => {
-                    let options =
-                        AnyTopOptions { rest_source: RestSource::Explicit { file: format!("{} (augmented rest)", clip.name) }, ..AnyTopOptions::default() };
+                    let options = RigOptions { rest_source: RestSource::Explicit { file: format!("{} (augmented rest)", clip.name) }, ..RigOptions::default() };
                     (AnyTopSection::new(&clip.skeleton, rest, &options)?, clip.skeleton.clone())
                 }
                 None => (AnyTopSection::of_clip(&clip.skeleton, &clip.motion, &clip.name)?, clip.skeleton.clone()),
             },
         };
         let e = section.rig.encode(&skeleton, &clip.motion)?;
-        let prepared = Prepared::new(&skeleton, section, NameTable::builtin()?, device)?;
+        let prepared = PreparedSkeleton::new(&skeleton, section, NameTable::builtin()?, device)?;
         Ok(Encoded { prepared, skeleton, features: e.features, placement: e.placement })
     };
     go().map_err(|e| println!("(skipped {}: {e:#})", clip.name)).ok()
@@ -212,7 +211,7 @@ fn distance(a: &Latents, b: &Latents) -> f64 {
 /// The first two frames of the clip `model` took `clip`'s rest pose from, when it knows the
 /// skeleton and the file is readable (the frames `AnyTopSection` measures a rig on).
 /// The clip comes back on the trained offsets (`KnownRig::fit`), the skeleton the rest fits.
-fn trained_rest(model: &Frozen, clip: &Clip) -> Option<Clip> {
+fn trained_rest(model: &FrozenAutoencoder, clip: &Clip) -> Option<Clip> {
     let known = model.rigs.find(&clip.skeleton)?;
     let (RestSource::TPose { file } | RestSource::FirstClip { file } | RestSource::Explicit { file }) = &known.section.rig.rest_source else { return None };
     let parsed = bvh::read_path(Path::new(file)).ok()?;
@@ -330,7 +329,7 @@ fn main() {
 
 /// Corpus pairs of one motion on two skeletons: CMU 131_01 and its scaled copy (same topology,
 /// other proportions). SAN error of SATA's transfer against the target's mean pose.
-fn ground_truth_pairs(models: &[(String, Frozen)], device: &Device) {
+fn ground_truth_pairs(models: &[(String, FrozenAutoencoder)], device: &Device) {
     let mut rows = Vec::new();
     let corpus = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bvh");
     let pairs = [("cmu_bvh11/131_01.bvh", "cmu_bvh11/scaled_131_01.bvh")];
@@ -360,7 +359,7 @@ fn ground_truth_pairs(models: &[(String, Frozen)], device: &Device) {
 }
 
 /// Encode + decode of a 1000-frame clip (a synthetic quadruped clip repeated), median of runs.
-fn speed(models: &[(String, Frozen)], device: &Device) {
+fn speed(models: &[(String, FrozenAutoencoder)], device: &Device) {
     let (skeleton, motion) = menagerie::synth::creature("quadruped", 0).expect("synthetic quadruped");
     let n = motion.joints;
     let mut long = motion.clone();

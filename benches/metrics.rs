@@ -17,18 +17,18 @@ use common::{median, ms, time_runs, RUNS};
 
 use menagerie::metrics::fid::{fid, FidOptions};
 use menagerie::metrics::generation::{generation_metrics, GenerationOptions, PointClip, PointFeatures};
-use menagerie::metrics::Clip;
+use menagerie::metrics::WorldClip;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig};
+use menagerie::repr::anytop::{AnyTopRig, RigOptions};
 use menagerie::rng::SplitMix64;
 use menagerie::skeleton::{roles, Skeleton};
 use menagerie::synth::creature;
 use std::hint::black_box;
 use std::path::Path;
 
-fn to_clip(skeleton: &Skeleton, motion: &Motion) -> Clip {
+fn to_clip(skeleton: &Skeleton, motion: &Motion) -> WorldClip {
     let world = motion.forward_kinematics(skeleton);
-    Clip {
+    WorldClip {
         frames: motion.frames,
         joints: motion.joints,
         fps: 1.0 / motion.frame_time.max(1e-9),
@@ -48,7 +48,7 @@ fn crop(p: &PointClip, start: usize, frames: usize) -> PointClip {
 
 fn point_clip(skeleton: &Skeleton, motion: &Motion) -> PointClip {
     let clip = to_clip(skeleton, motion);
-    let features = match AnyTopRig::new(skeleton, &motion.first_frames(2), &AnyTopOptions::default()) {
+    let features = match AnyTopRig::new(skeleton, &motion.first_frames(2), &RigOptions::default()) {
         Ok(rig) => PointFeatures { facing: Some(rig.facing.clone()), scale: Some(rig.scale_factor) },
         Err(_) => PointFeatures::default(),
     };

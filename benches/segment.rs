@@ -12,7 +12,7 @@
 //!   stored; numbers are only printed.
 //!
 //! Frame indices are BVH frames throughout: feature row t describes BVH frame t (AnyTop features
-//! have one row fewer than the clip; `mo_segment::segment_input` gives the last frame the label
+//! have one row fewer than the clip; `segment::input::segment_input` gives the last frame the label
 //! before it), so predicted and true boundaries count the same frames.
 //!
 //! Every row is one (feature provider, options) pair; a provider is a
@@ -23,11 +23,11 @@
 
 mod common;
 
-use menagerie::cli::mo_segment::{dift_features, raw_features, segment_input, window_frames, Input};
 use menagerie::diffusion::checkpoint;
 use menagerie::dift::DiftOptions;
 use menagerie::motion::Motion;
 use menagerie::rng::SplitMix64;
+use menagerie::segment::input::{dift_features, raw_features, segment_input, window_frames, Input, SegmentInputError};
 use menagerie::segment::{boundaries, boundary_errors, SegmentOptions};
 use menagerie::skeleton::Skeleton;
 use menagerie::synth::creature_names;
@@ -35,7 +35,7 @@ use menagerie::synth::{actions, training_clip, Action};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-type Provider<'a> = &'a dyn Fn(&Input) -> anyhow::Result<Vec<Vec<f64>>>;
+type Provider<'a> = &'a dyn Fn(&Input) -> Result<Vec<Vec<f64>>, SegmentInputError>;
 
 struct Case {
     input: Input,
@@ -206,7 +206,8 @@ fn main() {
     let model = checkpoint::frozen_default(&candle_core::Device::Cpu).expect("the built-in model");
     let dift = |input: &Input| dift_features(&model, input, &DiftOptions::TEMPORAL);
     // DIFT runs the denoiser per clip: only the main window settings for it.
-    let providers: Vec<(&str, Provider, &[usize])> = vec![("raw", &raw_features, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]), ("dift", &dift, &[0, 1, 4, 6])];
+    let raw = |input: &Input| Ok(raw_features(input));
+    let providers: Vec<(&str, Provider, &[usize])> = vec![("raw", &raw, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]), ("dift", &dift, &[0, 1, 4, 6])];
     let configs = vec![
         config("single frames k3 pca8 min10", 3, 8, 0.0, 10, false, true),
         config("window 0.5s k3 pca8 min10", 3, 8, 0.5, 10, false, true),

@@ -20,7 +20,7 @@ use common::{denoiser_forward_flops, median};
 
 use candle_core::{DType, Device, Tensor};
 use menagerie::cli::load::{expand_inputs, load_motions, LoadOptions};
-use menagerie::diffusion::data::{Augmentation, RawClip, TrainSet};
+use menagerie::diffusion::data::{Augmentation, TrainSet};
 use menagerie::diffusion::trainer::{step_rng, AnyTopOptions, AnyTopStart, AnyTopTrainer, Trainer};
 use menagerie::embed::NameTable;
 use menagerie::nn::DenoiserConfig;
@@ -103,7 +103,7 @@ fn main() {
     let build_set = || -> TrainSet {
         let files = expand_inputs(&data).expect("the training data");
         let loaded = load_motions(&files, &LoadOptions::default()).expect("readable BVH files");
-        let clips: Vec<RawClip> = loaded.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
+        let clips = loaded;
         let names = NameTable::builtin().expect("the built-in name table");
         TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation { probability: 0.0, variants: 0, seed }).expect("a training set").0
     };

@@ -11,7 +11,7 @@
 use candle_core::Device;
 use menagerie::cli::load::{expand_inputs, load_motions, LoadOptions};
 use menagerie::diffusion::checkpoint;
-use menagerie::diffusion::data::{Augmentation, RawClip, TrainSet};
+use menagerie::diffusion::data::{Augmentation, TrainSet};
 use menagerie::diffusion::Schedule;
 use menagerie::embed::NameTable;
 use menagerie::nn::{batch_from, BatchItem};
@@ -41,8 +41,7 @@ fn main() -> anyhow::Result<()> {
     let device = Device::Cpu;
     let loaded = checkpoint::load(std::path::Path::new(&args[0]), &device)?;
     let files = expand_inputs(&args[1..].iter().map(Into::into).collect::<Vec<_>>())?;
-    let clips: Vec<RawClip> =
-        load_motions(&files, &LoadOptions::default())?.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
+    let clips = load_motions(&files, &LoadOptions::default())?;
     let names = NameTable::builtin()?;
     let (set, _) = TrainSet::build(clips, names, loaded.info.dmax, &Augmentation::none())?;
     let schedule = loaded.info.schedule();

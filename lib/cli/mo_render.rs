@@ -3,7 +3,7 @@
 //! the sheet, GIF and HTML renderers. Every picture is drawn in memory before any file is
 //! written, so a bad input or option never leaves a partial or a stale-mixed set of outputs.
 
-use crate::cli::load::{expand_inputs, is_dash, load_motions, DecodeFrom, LoadOptions, Loaded};
+use crate::cli::load::{expand_inputs, is_dash, load_motions, DecodeFrom, LoadOptions};
 use crate::cli::CommonOpts;
 use crate::io;
 use crate::render::camera::Framing;
@@ -79,7 +79,7 @@ pub struct Args {
     pub from: DecodeFrom,
     /// Camera: auto, side, front, top, or YAW,PITCH in degrees (yaw about +y, 0 = side; pitch > 0
     /// looks down).
-    #[arg(long, value_name = "VIEW", default_value = "auto", value_parser = parse_view)]
+    #[arg(long, value_name = "VIEW", default_value = "auto", value_parser = View::parse)]
     pub view: View,
     /// Draw only frames START:END (END exclusive; either may be omitted: '100:', ':50').
     #[arg(long, value_name = "START:END", value_parser = parse_range)]
@@ -122,24 +122,6 @@ pub enum Kind {
     Sheet,
     Gif,
     Html,
-}
-
-fn parse_view(s: &str) -> Result<View, String> {
-    match s.to_ascii_lowercase().as_str() {
-        "auto" => Ok(View::Auto),
-        "side" => Ok(View::Side),
-        "front" => Ok(View::Front),
-        "top" => Ok(View::Top),
-        other => {
-            let (yaw, pitch) = other.split_once(',').ok_or_else(|| format!("expected auto, side, front, top or YAW,PITCH, found '{s}'"))?;
-            let yaw: f32 = yaw.trim().parse().map_err(|_| format!("yaw '{yaw}' is not a number (degrees)"))?;
-            let pitch: f32 = pitch.trim().parse().map_err(|_| format!("pitch '{pitch}' is not a number (degrees)"))?;
-            if !yaw.is_finite() || !pitch.is_finite() || pitch.abs() > 90.0 {
-                return Err(format!("pitch must be within -90..90 degrees, found '{s}'"));
-            }
-            Ok(View::Angle { yaw, pitch })
-        }
-    }
 }
 
 fn parse_range(s: &str) -> Result<(Option<usize>, Option<usize>), String> {
@@ -213,26 +195,6 @@ fn kind_of_extension(p: &Path) -> Option<Kind> {
     }
 }
 
-/// The first drawn frame and the tracks.
-fn tracks(loaded: &[Loaded], range: Option<(Option<usize>, Option<usize>)>) -> anyhow::Result<(usize, Vec<Track>)> {
-    let start = range.and_then(|r| r.0).unwrap_or(0);
-    let mut out = Vec::with_capacity(loaded.len());
-    for l in loaded {
-        let frames = l.motion.frames;
-        if frames == 0 {
-            bail!("{}: the motion has no frames (nothing to draw)", l.name);
-        }
-        let end = range.and_then(|r| r.1).unwrap_or(frames).min(frames);
-        if start >= end {
-            bail!("{}: --frames starts at frame {start} but the motion has {frames} frames (0..{})", l.name, frames - 1);
-        }
-        let motion = if start == 0 && end == frames { l.motion.clone() } else { l.motion.frame_range(start, end) };
-        let title = Path::new(&l.name).file_name().map_or(l.name.clone(), |f| f.to_string_lossy().into_owned());
-        out.push(Track::from_motion(&title, &l.skeleton, &motion));
-    }
-    Ok((start, out))
-}
-
 fn read_text(path: &Path) -> anyhow::Result<String> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
@@ -268,7 +230,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             bail!("{file}: segment {i} ends at frame {end}, but the longest motion has {longest} frames");
         }
     }
-    let (first_frame, mut tracks) = tracks(&loaded, args.frames)?;
+    let (first_frame, mut tracks) = Track::from_clips(&loaded, args.frames).map_err(anyhow::Error::msg)?;
     let skeletons: Vec<_> = loaded.iter().map(|l| &l.skeleton).collect();
     let legend = labels::apply(
         &mut tracks,
@@ -288,9 +250,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     io::write_all(&pictures.iter().map(|(b, p, _)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?;
     for (bytes, path, kind) in &pictures {
         let target = path.as_ref().map_or("stdout".to_string(), |p| p.display().to_string());
-        if args.common.verbose {
-            eprintln!("mo-render: wrote {kind:?} ({} bytes, {} motion(s)) to {target}", bytes.len(), tracks.len());
-        }
+        args.common.say("mo-render").info(format_args!("wrote {kind:?} ({} bytes, {} motion(s)) to {target}", bytes.len(), tracks.len()));
     }
     Ok(())
 }

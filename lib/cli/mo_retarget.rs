@@ -6,9 +6,10 @@
 use crate::binding::auto;
 use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips, BvhClip, MotionFormat};
-use crate::cli::CommonOpts;
-use crate::io::{self, npy};
+use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips, MotionFormat};
+use crate::cli::{output, CommonOpts};
+use crate::io;
+use crate::motion::Clip;
 use crate::motion::Motion;
 use crate::repr::m2m;
 use crate::retarget::{self, BoundRotation, Repr, RootMotion, Settings};
@@ -219,7 +220,7 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     let source = super::latent::read_source(&args.source, &model, &device)?;
     let target = super::latent::read_target(&target_path, &model, &device)?;
     let known = super::ood::Known::latent(args.model.as_deref(), &model.rigs)?;
-    for (name, skeleton) in [(&source.name, &source.skeleton), (&target.arg.name, &target.arg.skeleton)] {
+    for (name, skeleton) in [(&source.name, &source.skeleton), (&target.file.name, &target.file.skeleton)] {
         known.warn("mo-retarget", name, skeleton, args.common.quiet)?;
     }
     let latents = super::latent::encode(&model, &source, &device)?;
@@ -229,20 +230,14 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
             "mo-retarget: latent: {} ({} joints) -> {} ({} joints), {} frames, latent {} per frame, {:.2} s",
             source.name,
             source.skeleton.len(),
-            target.arg.name,
-            target.arg.skeleton.len(),
+            target.file.name,
+            target.file.skeleton.len(),
             latents.frames,
             latents.dims,
             started.elapsed().as_secs_f64()
         );
     }
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
-}
-
-type Clip = BvhClip;
-
-fn read_clip(path: &Path) -> anyhow::Result<Clip> {
-    read_bvh_clip(path, "mo-retarget")
 }
 
 fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Settings> {
@@ -323,77 +318,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let Some(bind) = args.bind.as_deref() else { bail!("--bind is required with --method m2m: a binding JSON file, or 'auto'") };
     let started = Instant::now();
     let count = args.samples as usize;
-    let outputs: Vec<Option<PathBuf>> = match args.common.output.as_deref() {
-        Some(p) if !is_dash(p) && !args.emit_binding && !(args.format == OutFormat::Npy) => {
-            (0..count).map(|i| io::numbered_output(p, i, count).map(Some).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?
-        }
-        Some(p) if !is_dash(p) => vec![Some(p.to_path_buf())],
-        _ if count > 1 && args.format != OutFormat::Npy && !args.emit_binding => {
-            bail!("{count} samples need a numbered output path such as -o 'out_{{i}}.bvh' (or --format npy for one batch)")
-        }
-        _ => vec![None],
-    };
-
-    let source = read_clip(&args.source)?;
-    if source.motion.frames < 2 {
-        bail!("{}: {} frame(s): a source motion needs at least two frames", source.name, source.motion.frames);
-    }
-    if args.targets.iter().any(|p| is_dash(p)) && is_dash(&args.source) {
-        bail!("stdin ('-') can be read only once");
-    }
-    let examples = read_example_clips(&args.targets, "mo-retarget", "target clips")?;
+    let outputs = output_paths(args, count)?;
+    let (source, examples) = read_inputs(args)?;
     let first = &examples[0];
-    for e in &examples {
-        if e.motion.frames < 2 {
-            bail!("{}: {} frame(s): example clips need at least two frames", e.name, e.motion.frames);
-        }
-    }
-    let target_fps = 1.0 / first.motion.frame_time;
-
-    // The binding.
-    let (map, binding): (JointMap, Binding) = if bind == "auto" {
-        let choices = super::correspond::bind_auto(
-            &super::correspond::Side { name: &source.name, skeleton: &source.skeleton, motion: &source.motion },
-            &super::correspond::Side { name: &first.name, skeleton: &first.skeleton, motion: &first.motion },
-            args.bind_rate,
-        )?;
-        let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
-        (choices.iter().map(|c| (c.source, c.target)).collect(), binding)
-    } else {
-        let path = Path::new(bind);
-        let name = io::display_name(path);
-        let text = String::from_utf8(io::read_input(path).with_context(|| format!("cannot read binding {name}"))?)
-            .map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))?;
-        let binding = Binding::from_json(&text, &name)?;
-        (binding.resolve(&name, &source.skeleton, &source.name, &first.skeleton, &first.name)?, binding)
-    };
+    let (map, binding) = binding_for(bind, &source, first, args.bind_rate)?;
     if args.emit_binding {
         return Ok(io::write_output(outputs[0].as_deref(), binding.to_json().as_bytes())?);
     }
-
-    // Frame rates.
-    let source_fps = 1.0 / source.motion.frame_time;
-    let source_motion = if (source_fps - target_fps).abs() > 1e-6 * target_fps {
-        let frames = (source.motion.frames - 1) as f64 * source.motion.frame_time * target_fps + 1.0;
-        if !(frames <= bounds::MAX_FRAMES as f64) {
-            bail!(
-                "{}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps ({}: Frame Time {}) would give {frames:.0} frames, more than {}",
-                source.name,
-                first.name,
-                first.motion.frame_time,
-                bounds::MAX_FRAMES
-            );
-        }
-        crate::budget::check_motion(&format!("{}: resampling", source.name), frames as usize, source.skeleton.len())?;
-        if !args.common.quiet {
-            eprintln!("mo-retarget: {}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps", source.name);
-        }
-        retarget::resample(&source.motion, target_fps)
-    } else {
-        source.motion.clone()
-    };
-
-    let settings = settings(args, target_fps, source_motion.frames)?;
+    let source_motion = at_rate_of(&source, first, args.common.say("mo-retarget"))?;
+    let settings = settings(args, 1.0 / first.motion.frame_time, source_motion.frames)?;
     let out_frames = settings.frames.unwrap_or(source_motion.frames);
     if out_frames > bounds::MAX_FRAMES {
         bail!("{}: {out_frames} output frames, more than {} (give --frames or --seconds)", source.name, bounds::MAX_FRAMES);
@@ -407,38 +340,27 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .with_context(|| format!("{} -> {}", source.name, first.name))?;
     let retargeted = t0.elapsed();
 
-    // Everything to bytes first, then write.
+    // Everything to bytes first, then write all samples or none.
     let t1 = Instant::now();
-    let mut files: Vec<(Option<PathBuf>, Vec<u8>)> = Vec::new();
-    match args.format {
-        OutFormat::Bvh | OutFormat::Glb | OutFormat::Gltf => {
-            for (r, out) in results.iter().zip(&outputs) {
-                files.push((out.clone(), motion_file(&first.skeleton, &r.motion, out.as_deref(), args.format.motion())?));
-            }
-        }
+    let files: Vec<(Option<PathBuf>, Vec<u8>)> = match args.format {
         OutFormat::Npy => {
+            output::refuse_terminal(outputs[0].as_deref(), "NPY", "give -o FILE or redirect stdout")?;
             let features: Vec<_> = results.iter().map(|r| m2m::encode(&r.motion)).collect();
-            let f0 = &features[0];
-            let mut shape = vec![f0.frames, f0.joints, f0.dims];
-            if features.len() > 1 {
-                shape.insert(0, features.len());
-            }
-            let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
-            let mut bytes = Vec::new();
-            npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-            files.push((outputs[0].clone(), bytes));
+            vec![(outputs[0].clone(), output::features_npy(&features, false)?)]
         }
-    }
-    if args.format == OutFormat::Npy {
-        io::refuse_terminal(outputs[0].as_deref(), "NPY", "give -o FILE or redirect stdout")?;
-    }
-    // All samples or none.
-    io::write_all(&files.iter().map(|(p, b)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?;
+        _ => results
+            .iter()
+            .zip(&outputs)
+            .map(|(r, out)| Ok((out.clone(), motion_file(&first.skeleton, &r.motion, out.as_deref(), args.format.motion())?)))
+            .collect::<anyhow::Result<_>>()?,
+    };
+    output::write_all(&files)?;
     let written = t1.elapsed();
 
     if args.report && !args.common.quiet {
-        eprintln!(
-            "mo-retarget: {} ({} frames, {} joints) -> {} ({} example clip(s), {} frames, {} joints)",
+        let say = |line: &str| eprintln!("mo-retarget: {line}");
+        say(&format!(
+            "{} ({} frames, {} joints) -> {} ({} example clip(s), {} frames, {} joints)",
             source.name,
             source_motion.frames,
             source.skeleton.len(),
@@ -446,45 +368,86 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             examples.len(),
             examples.iter().map(|e| e.motion.frames).sum::<usize>(),
             first.skeleton.len()
-        );
-        eprintln!("mo-retarget: binding: {} pairs, rate {:.1}%", map.len(), 100.0 * Binding::rate(map.len(), source.skeleton.len(), first.skeleton.len()));
+        ));
+        say(&format!("binding: {} pairs, rate {:.1}%", map.len(), 100.0 * Binding::rate(map.len(), source.skeleton.len(), first.skeleton.len())));
         for (p, &(s, t)) in binding.mapping.iter().zip(&map) {
             let score = p.score.map(|x| format!(" (score {x:.3})")).unwrap_or_default();
-            eprintln!("mo-retarget:   {} -> {}{score}", source.skeleton.joints[s].name, first.skeleton.joints[t].name);
+            say(&format!("  {} -> {}{score}", source.skeleton.joints[s].name, first.skeleton.joints[t].name));
         }
         for (i, r) in results.iter().enumerate() {
-            let rep = &r.report;
-            eprintln!(
-                "mo-retarget: sample {i} (seed {}): {} frames ({} constrained by the source), patch {}, {} of {} channels bound, synthesis {:.1} ms",
-                seeds[i],
-                rep.frames,
-                rep.known_frames,
-                rep.patch,
-                rep.bound_channels,
-                rep.channels,
-                rep.timings.synthesis.as_secs_f64() * 1e3
-            );
-            for (l, level) in rep.levels.iter().enumerate() {
-                let costs: Vec<String> = level.step_costs.iter().map(|c| format!("{c:.4}")).collect();
-                eprintln!(
-                    "mo-retarget:   level {l}: {} frames, {} example patches, {} steps, match cost per step [{}]",
-                    level.frames,
-                    level.example_patches,
-                    level.steps,
-                    costs.join(", ")
-                );
-            }
-            for note in &rep.notes {
-                eprintln!("mo-retarget:   note: {note}");
-            }
+            r.report.describe(i, seeds[i]).iter().for_each(|line| say(line));
         }
-        eprintln!(
-            "mo-retarget: time: load {:.1} ms, retarget {:.1} ms, write {:.1} ms, total {:.1} ms",
-            loaded.as_secs_f64() * 1e3,
-            retargeted.as_secs_f64() * 1e3,
-            written.as_secs_f64() * 1e3,
-            started.elapsed().as_secs_f64() * 1e3
-        );
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        let total = ms(started.elapsed());
+        say(&format!("time: load {:.1} ms, retarget {:.1} ms, write {:.1} ms, total {total:.1} ms", ms(loaded), ms(retargeted), ms(written)));
     }
     Ok(())
+}
+
+/// Where the samples go: one numbered file each, one file (a binding, an NPY batch), or stdout.
+fn output_paths(args: &Args, count: usize) -> anyhow::Result<Vec<Option<PathBuf>>> {
+    Ok(match args.common.output.as_deref() {
+        Some(p) if !is_dash(p) && !args.emit_binding && !(args.format == OutFormat::Npy) => output::numbered(p, count)?.into_iter().map(Some).collect(),
+        Some(p) if !is_dash(p) => vec![Some(p.to_path_buf())],
+        _ if count > 1 && args.format != OutFormat::Npy && !args.emit_binding => {
+            bail!("{count} samples need a numbered output path such as -o 'out_{{i}}.bvh' (or --format npy for one batch)")
+        }
+        _ => vec![None],
+    })
+}
+
+/// The source and the target's example clips, each at least two frames long.
+fn read_inputs(args: &Args) -> anyhow::Result<(Clip, Vec<Clip>)> {
+    let source = read_bvh_clip(&args.source, "mo-retarget")?;
+    if source.motion.frames < 2 {
+        bail!("{}: {} frame(s): a source motion needs at least two frames", source.name, source.motion.frames);
+    }
+    if args.targets.iter().any(|p| is_dash(p)) && is_dash(&args.source) {
+        bail!("stdin ('-') can be read only once");
+    }
+    let examples = read_example_clips(&args.targets, "mo-retarget", "target clips")?;
+    if let Some(e) = examples.iter().find(|e| e.motion.frames < 2) {
+        bail!("{}: {} frame(s): example clips need at least two frames", e.name, e.motion.frames);
+    }
+    Ok((source, examples))
+}
+
+/// The binding of `--bind`: computed (`auto`) or read from a file, as joint pairs and as the
+/// document `--emit-binding` writes.
+fn binding_for(bind: &str, source: &Clip, first: &Clip, rate: Option<f64>) -> anyhow::Result<(JointMap, Binding)> {
+    if bind == "auto" {
+        let choices = crate::binding::clips::bind_auto(source, first, rate)?;
+        let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
+        return Ok((choices.iter().map(|c| (c.source, c.target)).collect(), binding));
+    }
+    let path = Path::new(bind);
+    let name = io::display_name(path);
+    let text = String::from_utf8(io::read_input(path).with_context(|| format!("cannot read binding {name}"))?)
+        .map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))?;
+    let binding = Binding::from_json(&text, &name)?;
+    Ok((binding.resolve(&name, &source.skeleton, &source.name, &first.skeleton, &first.name)?, binding))
+}
+
+/// The source's motion at the examples' frame rate (resampled, with a note, when it differs).
+fn at_rate_of(source: &Clip, first: &Clip, say: output::Say) -> anyhow::Result<Motion> {
+    let target_fps = 1.0 / first.motion.frame_time;
+    let source_fps = 1.0 / source.motion.frame_time;
+    if (source_fps - target_fps).abs() <= 1e-6 * target_fps {
+        return Ok(source.motion.clone());
+    }
+    let frames = (source.motion.frames - 1) as f64 * source.motion.frame_time * target_fps + 1.0;
+    if !(frames <= bounds::MAX_FRAMES as f64) {
+        bail!(
+            "{}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps ({}: Frame Time {}) would give {frames:.0} frames, more than {}",
+            source.name,
+            first.name,
+            first.motion.frame_time,
+            bounds::MAX_FRAMES
+        );
+    }
+    crate::budget::check_motion(&format!("{}: resampling", source.name), frames as usize, source.skeleton.len())?;
+    if !say.quiet {
+        eprintln!("mo-retarget: {}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps", source.name);
+    }
+    Ok(retarget::resample(&source.motion, target_fps))
 }

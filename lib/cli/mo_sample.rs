@@ -2,14 +2,14 @@
 //! clips of it without a model (`--examples`, in `mo_sample_examples`).
 
 use crate::cli::load::read_skeleton;
-use crate::cli::CommonOpts;
+use crate::cli::{output, CommonOpts};
 use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit::{self, KeepMask};
 use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
 use crate::diffusion::Sampler;
-use crate::io::{self, npy};
-use crate::repr::anytop::{IkOptions, FEATURE_DIMS};
+use crate::io;
+use crate::repr::anytop::{AnyTopRig, IkOptions, Placement};
 use crate::repr::smooth::lambda_for_cutoff;
 use crate::repr::Features;
 use anyhow::{bail, Context};
@@ -189,6 +189,15 @@ pub enum SamplerArg {
     Ddim,
 }
 
+impl SamplerArg {
+    fn sampler(self) -> Sampler {
+        match self {
+            SamplerArg::Ddpm => Sampler::Ddpm,
+            SamplerArg::Ddim => Sampler::Ddim,
+        }
+    }
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     if !args.examples.is_empty() {
@@ -199,10 +208,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     crate::nn::keep_freed_memory();
     let count = args.samples as usize;
-    let outputs: Option<Vec<PathBuf>> = match &args.bvh {
-        Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
-        None => None,
-    };
+    let outputs = args.bvh.as_deref().map(|p| output::numbered(p, count)).transpose()?;
     let dash = PathBuf::from("-");
     let arg = read_skeleton(args.skeleton.as_ref().or(args.skeleton_option.as_ref()).or(args.reference.as_ref()).unwrap_or(&dash))?;
     let skeleton = &arg.skeleton;
@@ -235,38 +241,23 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // joint and frame.
     let tokens = count as u128 * frames as u128 * skeleton.len() as u128;
     crate::budget::check(&format!("{count} samples of {frames} frames on {} joints", skeleton.len()), tokens, loaded.info.config.width * 4 * 4)?;
-    let mask = match &reference {
-        Some(r) => Some(keep_mask(args, r, skeleton, frames)?),
-        None => None,
-    };
+    let mask = reference.as_ref().map(|r| keep_mask(args, r, skeleton, frames)).transpose()?;
 
     let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, section.stats.as_ref()).with_context(|| arg.name.clone())?;
     if condition.stats_source == StatsSource::Fallback && !args.common.quiet {
         eprintln!("mo-sample: {}: not a trained skeleton and no statistics in it: normalising by its rest pose and the trained skeletons' spreads", arg.name);
     }
     let cond = condition.condition();
-    let sampler = match args.sampler {
-        SamplerArg::Ddpm => Sampler::Ddpm,
-        SamplerArg::Ddim => Sampler::Ddim,
-    };
     let lambda = smoothing(args.smooth, fps)?;
     if !(args.blend.is_finite() && args.blend >= 0.0 && args.blend <= crate::cli::bounds::MAX_SECONDS) {
         bail!("--blend must be a duration in seconds (>= 0), found {}", args.blend);
     }
     let blend = (args.blend * fps).round() as usize;
     let schedule = loaded.info.schedule();
-    let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler, seed: args.common.seed };
+    let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler: args.sampler.sampler(), seed: args.common.seed };
     let started = std::time::Instant::now();
     let mut samples = match (&reference, &mask) {
-        (Some(r), Some(mask)) => {
-            // Frames past the reference's end are generated; their reference values are unused.
-            let mut padded = r.features.clone();
-            if padded.frames < frames {
-                padded.data.resize(frames * padded.joints * padded.dims, 0.0);
-                padded.frames = frames;
-            }
-            edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &padded, mask, &device)?
-        }
+        (Some(r), Some(mask)) => edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &r.features.padded_to(frames), mask, &device)?,
         _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
     };
     let fixed = mask.as_ref().map(|m| m.keep.as_slice());
@@ -275,34 +266,41 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         post.apply(f, &section.rig.feet, fixed);
     }
     if let (true, Some(r), Some(mask)) = (args.report, &reference, &mask) {
-        eprintln!("{}", seam_report(&section.rig, skeleton, r, mask, &samples)?);
+        let report =
+            edit::seam_report(&section.rig, skeleton, (&r.name, &r.features, &r.placement), mask, &samples).map_err(|e| anyhow::anyhow!("--report: {e}"))?;
+        eprintln!("{report}");
     }
-    if args.common.verbose {
-        eprintln!("mo-sample: {count} x {frames} frames in {:.2} s", started.elapsed().as_secs_f64());
-    }
+    args.common.say("mo-sample").info(format_args!("{count} x {frames} frames in {:.2} s", started.elapsed().as_secs_f64()));
 
+    // An edit stands where its reference stood, so kept frames land on the reference's.
+    let placement = reference.as_ref().map_or_else(|| section.rig.rest_placement(), |r| r.placement);
+    write_samples(args, outputs, &samples, &section.rig, skeleton, &placement)
+}
+
+/// The samples as BVH files (`--bvh PATTERN`, all or none) or one NPY batch.
+fn write_samples(
+    args: &Args,
+    outputs: Option<Vec<PathBuf>>,
+    samples: &[Features],
+    rig: &AnyTopRig,
+    skeleton: &crate::skeleton::Skeleton,
+    placement: &Placement,
+) -> anyhow::Result<()> {
     match outputs {
         Some(paths) => {
-            // An edit stands where its reference stood, so kept frames land on the reference's.
-            let placement = reference.as_ref().map_or_else(|| section.rig.rest_placement(), |r| r.placement);
-            let mut texts = Vec::with_capacity(count);
-            for (i, f) in samples.iter().enumerate() {
-                let motion = section.rig.decode_ik(skeleton, f, &placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
-                texts.push(crate::cli::load::motion_file(skeleton, &motion, Some(&paths[i]), crate::cli::load::MotionFormat::Bvh)?);
+            let mut files = Vec::with_capacity(paths.len());
+            for (i, (f, path)) in samples.iter().zip(paths).enumerate() {
+                let motion = rig.decode_ik(skeleton, f, placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
+                let bytes = crate::cli::load::motion_file(skeleton, &motion, Some(&path), crate::cli::load::MotionFormat::Bvh)?;
+                files.push((Some(path), bytes));
             }
-            // All samples or none.
-            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_slice())).collect::<Vec<_>>())?;
+            output::write_all(&files)
         }
         None => {
-            io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
-            let shape = [count, frames, skeleton.len(), FEATURE_DIMS];
-            let parts: Vec<&[f32]> = samples.iter().map(|f| f.data.as_slice()).collect();
-            let mut bytes = Vec::new();
-            npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-            io::write_output(args.common.output.as_deref(), &bytes)?;
+            output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
+            Ok(io::write_output(args.common.output.as_deref(), &output::features_npy(samples, true)?)?)
         }
     }
-    Ok(())
 }
 
 /// The smoother's weight for `--smooth HZ` at `fps`; `None` for 0 (raw output).
@@ -328,13 +326,15 @@ fn read_reference(
 ) -> anyhow::Result<Reference> {
     let name = io::display_name(path);
     let bytes = io::read_input(path).with_context(|| format!("cannot read the reference {name}"))?;
-    let parsed = crate::cli::load::parse_motion(&bytes, &name, path).with_context(|| format!("the reference {name}"))?;
-    let own = crate::skeleton::Skeleton::from_bvh(&parsed);
-    own.validate().with_context(|| name.clone())?;
-    if let Some(diff) = skeleton.first_difference(&own) {
+    // Parse errors say it is the reference; a bad skeleton's message names the file already.
+    let clip = crate::cli::load::clip_from_bytes(&bytes, &name, path).map_err(|e| match e {
+        e @ crate::motion::ClipError::Skeleton { .. } => anyhow::Error::new(e),
+        e => anyhow::Error::new(e).context(format!("the reference {name}")),
+    })?;
+    if let Some(diff) = skeleton.first_difference(&clip.skeleton) {
         bail!("the reference {name} is not on the skeleton of {skeleton_name}: {diff}");
     }
-    let motion = crate::motion::Motion::from_bvh(&parsed, &own);
+    let motion = clip.motion;
     if motion.frames < 2 {
         bail!("the reference {name} has {} frame(s); AnyTop features need at least 2", motion.frames);
     }
@@ -360,41 +360,4 @@ fn keep_mask(args: &Args, r: &Reference, skeleton: &crate::skeleton::Skeleton, f
         bail!("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate");
     }
     Ok(mask)
-}
-
-/// `--report`: seam jumps per sample against the reference clip's own distribution (one JSON line).
-fn seam_report(
-    rig: &crate::repr::anytop::AnyTopRig,
-    skeleton: &crate::skeleton::Skeleton,
-    r: &Reference,
-    mask: &KeepMask,
-    samples: &[Features],
-) -> anyhow::Result<String> {
-    let j = skeleton.len();
-    let positions = |f: &Features| rig.recover_positions(skeleton, f, &r.placement).map_err(|e| anyhow::anyhow!("--report: {e}"));
-    let reference = positions(&r.features)?;
-    let distribution = edit::jump_distribution([(reference.as_slice(), j)]);
-    let kept = mask.whole_frames();
-    let mut rows = Vec::with_capacity(samples.len());
-    for f in samples {
-        let p = positions(f)?;
-        let seams = edit::seam_jump(&p, j, &kept);
-        let max = seams.iter().map(|s| s.jump).fold(0.0, f64::max);
-        // The same number inside the generated stretch (boundaries between two generated
-        // frames): a seam as smooth as the model's own motion matches it.
-        let jumps = edit::boundary_jumps(&p, j);
-        let inside: Vec<f64> = (1..kept.len()).filter(|&b| !kept[b] && !kept[b - 1]).filter_map(|b| jumps.get(b - 1).copied()).collect();
-        let generated = edit::jump_distribution_of(inside);
-        rows.push(serde_json::json!({ "seams": seams, "max_seam_jump": max, "generated_jumps": generated }));
-    }
-    let report = serde_json::json!({
-        "report": "seam_jump",
-        "units": "BVH units per frame",
-        "reference": r.name,
-        "kept_frames": kept.iter().filter(|&&k| k).count(),
-        "kept_cells": mask.count(),
-        "reference_jumps": distribution,
-        "samples": rows,
-    });
-    Ok(report.to_string())
 }

@@ -4,23 +4,20 @@
 //! writes BVH on the examples' skeleton or Motion2Motion features, all outputs or none.
 
 use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
-use crate::cli::bounds;
-use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton, BvhClip};
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
+use crate::cli::{bounds, output};
 use crate::diffusion::edit;
 use crate::genmm::{self, Keep, Settings};
-use crate::io::{self, npy};
+use crate::io;
+use crate::motion::Clip;
 use crate::repr::m2m;
 use anyhow::{bail, Context};
-use std::path::PathBuf;
 use std::time::Instant;
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let count = args.samples as usize;
-    let outputs: Option<Vec<PathBuf>> = match &args.bvh {
-        Some(p) => Some((0..count).map(|i| io::numbered_output(p, i, count).map_err(anyhow::Error::msg)).collect::<anyhow::Result<_>>()?),
-        None => None,
-    };
+    let outputs = args.bvh.as_deref().map(|p| output::numbered(p, count)).transpose()?;
     let skeleton_path = args.skeleton.as_ref().or(args.skeleton_option.as_ref());
     let dashes = args.examples.iter().chain(skeleton_path).chain(args.reference.as_ref()).filter(|p| is_dash(p)).count();
     if dashes > 1 {
@@ -40,10 +37,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let frame_time = first.motion.frame_time;
     let fps = if frame_time > 0.0 { 1.0 / frame_time } else { 30.0 };
-    let reference = match &args.reference {
-        Some(path) => Some(read_reference(path, first)?),
-        None => None,
-    };
+    let reference = args.reference.as_deref().map(|path| read_reference(path, first)).transpose()?;
     let frames = match (args.seconds, args.frames, &reference) {
         (Some(s), _, _) => match bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
             n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
@@ -54,10 +48,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (None, None, None) => clips.iter().map(|c| c.motion.frames).max().unwrap_or(1),
     };
     crate::budget::check_motion(&format!("{count} samples of {frames} frames"), count.saturating_mul(frames), skeleton.len())?;
-    let keep = match &reference {
-        Some(r) => Some(keep(args, r, frames)?),
-        None => None,
-    };
+    let keep = reference.as_ref().map(|r| keep(args, r, frames)).transpose()?;
 
     let motions: Vec<crate::motion::Motion> = clips.iter().map(|c| c.motion.clone()).collect();
     let settings = Settings { frames: Some(frames), ..Settings::default() };
@@ -69,47 +60,39 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.report {
         eprintln!("{}", report(&clips, &generated, generation));
     }
-    if args.common.verbose {
-        eprintln!("mo-sample: {count} x {frames} frames from {} example clip(s) in {:.3} s", clips.len(), generation.as_secs_f64());
-    }
+    let say = args.common.say("mo-sample");
+    say.info(format_args!("{count} x {frames} frames from {} example clip(s) in {:.3} s", clips.len(), generation.as_secs_f64()));
     if !args.common.quiet {
         let mut notes: Vec<&String> = generated.iter().flat_map(|g| &g.report.notes).collect();
         notes.dedup();
         notes.sort();
         notes.dedup();
         for note in notes {
-            eprintln!("mo-sample: note: {note}");
+            say.note(note);
         }
     }
 
     match outputs {
         Some(paths) => {
-            let texts = generated
+            let files = generated
                 .iter()
-                .zip(&paths)
-                .map(|(g, p)| crate::cli::load::motion_file(skeleton, &g.motion, Some(p), crate::cli::load::MotionFormat::Bvh))
-                .collect::<anyhow::Result<Vec<Vec<u8>>>>()?;
-            // All samples or none.
-            io::write_all(&paths.iter().zip(&texts).map(|(p, t)| (Some(p.as_path()), t.as_slice())).collect::<Vec<_>>())?;
+                .zip(paths)
+                .map(|(g, p)| Ok((Some(p.clone()), crate::cli::load::motion_file(skeleton, &g.motion, Some(&p), crate::cli::load::MotionFormat::Bvh)?)))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            output::write_all(&files)?;
         }
         None => {
-            io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
+            output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
             let features: Vec<_> = generated.iter().map(|g| m2m::encode(&g.motion)).collect();
-            let shape = [count, frames, skeleton.len(), m2m::DIMS];
-            let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
-            let mut bytes = Vec::new();
-            npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-            io::write_output(args.common.output.as_deref(), &bytes)?;
+            io::write_output(args.common.output.as_deref(), &output::features_npy(&features, true)?)?;
         }
     }
-    if args.common.verbose {
-        eprintln!("mo-sample: total {:.3} s", started.elapsed().as_secs_f64());
-    }
+    say.info(format_args!("total {:.3} s", started.elapsed().as_secs_f64()));
     Ok(())
 }
 
 /// `--reference`: a clip of the examples' skeleton at their frame rate.
-fn read_reference(path: &std::path::Path, first: &BvhClip) -> anyhow::Result<BvhClip> {
+fn read_reference(path: &std::path::Path, first: &Clip) -> anyhow::Result<Clip> {
     let r = read_bvh_clip(path, "mo-sample --reference")?;
     if let Some(why) = first.skeleton.first_difference(&r.skeleton) {
         bail!("the reference {} is not on the skeleton of the example clips ({}): {why}", r.name, first.name);
@@ -132,7 +115,7 @@ fn read_reference(path: &std::path::Path, first: &BvhClip) -> anyhow::Result<Bvh
 
 /// What `--keep-frames` and `--keep-joints` keep: frames must exist in both the output and the
 /// reference; joints are kept over every output frame the reference has.
-fn keep<'a>(args: &Args, r: &'a BvhClip, frames: usize) -> anyhow::Result<Keep<'a>> {
+fn keep<'a>(args: &Args, r: &'a Clip, frames: usize) -> anyhow::Result<Keep<'a>> {
     let known = frames.min(r.motion.frames);
     let mut kept_frames = vec![false; frames];
     if let Some(text) = &args.keep_frames {
@@ -156,7 +139,7 @@ fn keep<'a>(args: &Args, r: &'a BvhClip, frames: usize) -> anyhow::Result<Keep<'
 }
 
 /// `--report`: the synthesis of every sample, one JSON line.
-fn report(clips: &[BvhClip], generated: &[genmm::Generated], time: std::time::Duration) -> String {
+fn report(clips: &[Clip], generated: &[genmm::Generated], time: std::time::Duration) -> String {
     let samples: Vec<serde_json::Value> = generated
         .iter()
         .map(|g| {

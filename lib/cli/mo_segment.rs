@@ -8,15 +8,13 @@ use crate::cli::bounds;
 use crate::cli::load::{is_dash, read_skeleton, split_samples};
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
-use crate::dift::{self, DiftOptions};
-use crate::document::AnyTopSection;
+use crate::dift::DiftOptions;
 use crate::io::{self, npy};
-use crate::motion::Motion;
+use crate::motion::Clip;
 use crate::repr::anytop::FEATURE_DIMS;
-use crate::repr::Features as ReprFeatures;
-use crate::segment::{self, SegmentOptions, Segmentation};
-use crate::skeleton::Skeleton;
-use anyhow::{anyhow, bail, Context};
+use crate::segment::input::{dift_features, raw_features, segment_input, usable_frame_time, window_frames, Input};
+use crate::segment::{SegmentOptions, Segmentation};
+use anyhow::{bail, Context};
 use std::path::PathBuf;
 
 const EXAMPLES: &str = "\
@@ -120,60 +118,6 @@ impl Features {
     }
 }
 
-/// A motion to segment, as its AnyTop features: what every feature provider gets.
-pub struct Input {
-    /// File name for messages and the report.
-    pub name: String,
-    /// Motion frames the labels cover: the BVH's frames, or the features' frames + 1 for an
-    /// NPY (AnyTop features of an F-frame clip have F − 1 frames).
-    pub frames: usize,
-    /// Seconds per frame: the BVH's (or the --skeleton BVH's); 1/30 (AnyTop's rate) otherwise.
-    pub frame_time: f64,
-    /// `[frames − 1, joints, 13]` AnyTop features in physical units (as `mo-encode` writes them
-    /// without --normalise).
-    pub anytop: ReprFeatures,
-    /// The skeleton and the AnyTop record the features were made with, when known (a BVH
-    /// input, or an NPY with --skeleton); a model-based provider needs them.
-    pub skeleton: Option<(Skeleton, AnyTopSection)>,
-}
-
-impl Input {
-    /// A motion with a rig built on its own first two frames: AnyTop's rule for a clip without
-    /// a T-pose file, the rig `mo-encode` builds for a single input, so `mo-encode clip.bvh |
-    /// mo-segment` and `mo-segment clip.bvh` see the same features.
-    pub fn from_motion(name: String, skeleton: Skeleton, motion: Motion) -> anyhow::Result<Input> {
-        if motion.frames < 2 {
-            bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
-        }
-        let section = AnyTopSection::of_clip(&skeleton, &motion, &name).with_context(|| format!("{name}: cannot build an AnyTop rig"))?;
-        Input::with_record(name, skeleton, motion, section)
-    }
-
-    /// A motion encoded with a given AnyTop record (a skeleton document's).
-    pub fn with_record(name: String, skeleton: Skeleton, motion: Motion, section: AnyTopSection) -> anyhow::Result<Input> {
-        if motion.frames < 2 {
-            bail!("{name}: {} frame(s); segmenting needs at least 2 (AnyTop features need the next frame)", motion.frames);
-        }
-        let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| anyhow!("{name}: {e}"))?;
-        let frame_time = usable_frame_time(motion.frame_time);
-        Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)) })
-    }
-}
-
-fn usable_frame_time(t: f64) -> f64 {
-    if t.is_finite() && t > 0.0 {
-        t
-    } else {
-        1.0 / 30.0
-    }
-}
-
-/// `--features raw`: `segment::raw_frame_features` of the clip's AnyTop features, one row per
-/// BVH frame but the last.
-pub fn raw_features(input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
-    Ok(segment::raw_frame_features(&input.anytop))
-}
-
 /// One feature vector per frame of `input` for `--features`, row t describing BVH frame t (rows
 /// may stop short of the last frames; `segment_input` gives those the last row's label; all rows
 /// the same length, finite). New feature kinds (DIFT) are one more `Features` variant and one
@@ -181,7 +125,7 @@ pub fn raw_features(input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
 /// `args` and the skeleton and rig from `input.skeleton`.
 pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>>> {
     match args.features {
-        Features::Raw => raw_features(input),
+        Features::Raw => Ok(raw_features(input)),
         Features::Dift => {
             let device = candle_core::Device::Cpu;
             let model = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
@@ -189,42 +133,9 @@ pub fn frame_features(args: &Args, input: &Input) -> anyhow::Result<Vec<Vec<f64>
             if let Some((skeleton, _)) = &input.skeleton {
                 super::ood::Known::denoiser(args.model.as_deref(), &model.info)?.warn("mo-segment", &input.name, skeleton, args.common.quiet)?;
             }
-            dift_features(&model, input, &opts)
+            Ok(dift_features(&model, input, &opts)?)
         }
     }
-}
-
-/// `--features dift`: DIFT features averaged over joints, one row per AnyTop feature frame.
-pub fn dift_features(model: &checkpoint::Frozen, input: &Input, opts: &DiftOptions) -> anyhow::Result<Vec<Vec<f64>>> {
-    let Some((skeleton, section)) = &input.skeleton else {
-        bail!("{}: DIFT features need the skeleton: give --skeleton (a skeleton document or BVH) with an NPY input", input.name);
-    };
-    let prepared = dift::prepare_encoded(&model.info, skeleton, &section.rest_row, input.anytop.clone(), &input.name)?;
-    let schedule = model.info.schedule();
-    let f = dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, &candle_core::Device::Cpu)
-        .with_context(|| input.name.clone())?;
-    Ok(f.per_frame().into_iter().map(|row| row.into_iter().map(f64::from).collect()).collect())
-}
-
-/// `--window` seconds as frames at `frame_time` (0 = none).
-pub fn window_frames(seconds: f64, frame_time: f64) -> usize {
-    if seconds > 0.0 && frame_time > 0.0 {
-        (seconds / frame_time).round() as usize
-    } else {
-        0
-    }
-}
-
-/// Segment `features` of `input` and return the result in BVH frames (labels extended to every
-/// frame of the motion, segments recomputed on them).
-pub fn segment_input(input: &Input, features: &[Vec<f64>], options: &SegmentOptions, seed: u64) -> anyhow::Result<Segmentation> {
-    if features.is_empty() {
-        bail!("{}: no feature frames to segment", input.name);
-    }
-    let mut s = segment::segment(features, options, seed).with_context(|| format!("{}: cannot segment", input.name))?;
-    s.labels = segment::extend_labels(&s.labels, input.frames);
-    s.segments = segment::segments(&s.labels);
-    Ok(s)
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -271,11 +182,8 @@ fn load(args: &Args) -> anyhow::Result<Input> {
         None => None,
     };
     if !npy::looks_like_npy(&args.input, &bytes) {
-        let parsed = crate::cli::load::parse_motion(&bytes, &name, &args.input)?;
+        let Clip { skeleton: own, motion, .. } = crate::cli::load::clip_from_bytes(&bytes, &name, &args.input)?;
         drop(bytes);
-        let own = Skeleton::from_bvh(&parsed);
-        own.validate().with_context(|| name.clone())?;
-        let motion = Motion::from_bvh(&parsed, &own);
         return match skeleton {
             // The skeleton's own record, so the features are those mo-encode makes with it.
             Some(arg) => {
@@ -283,12 +191,12 @@ fn load(args: &Args) -> anyhow::Result<Input> {
                     bail!("{name} is not on the skeleton of {}: {diff}", arg.name);
                 }
                 let section = arg.record()?;
-                Input::with_record(name, own, motion, section)
+                Ok(Input::with_record(name, own, motion, section)?)
             }
-            None => Input::from_motion(name, own, motion),
+            None => Ok(Input::from_motion(name, own, motion)?),
         };
     }
-    let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name)?;
+    let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name).map_err(anyhow::Error::msg)?;
     if batch {
         bail!("{name}: a batch of {} samples; mo-segment takes one motion (a [frames, joints, 13] array)", samples.len());
     }

@@ -3,7 +3,7 @@
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
-use crate::diffusion::data::{Augmentation, RawClip, TrainSet};
+use crate::diffusion::data::{Augmentation, TrainSet};
 use crate::diffusion::trainer::{
     refuse_existing, train_loop, AnyTopInit, AnyTopOptions, AnyTopResume, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer,
 };
@@ -159,7 +159,6 @@ pub struct Args {
     pub common: CommonOpts,
 }
 
-/// A probability: a decimal in [0, 1] or a fraction `a/b`.
 /// A moving-average decay: a number in [0, 1) (1 would never move).
 fn parse_decay(text: &str) -> Result<f64, String> {
     let value: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number"))?;
@@ -170,6 +169,7 @@ fn parse_decay(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A probability: a decimal in [0, 1] or a fraction `a/b`.
 fn parse_probability(text: &str) -> Result<f64, String> {
     let value = match text.split_once('/') {
         Some((a, b)) => {
@@ -305,89 +305,90 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let device = Device::Cpu;
     let done = match args.arch {
-        Arch::Anytop => {
-            let opts = AnyTopOptions {
-                config: args.preset.config(),
-                seed: args.common.seed,
-                lr: resolved.lr,
-                batch: args.batch as usize,
-                crop: args.crop.unwrap_or(40) as usize,
-                lambda_geo: args.lambda_geo,
-                lambda_vel: args.lambda_vel,
-                augment: resolved.augment,
-                augment_variants: args.augment_variants as usize,
-                ema: args.ema,
-                noise_shift: args.noise_shift,
-                weighting: args.loss_weighting,
-            };
-            // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.
-            refuse_to_overwrite(args)?;
-            // The checkpoint first: a resumed run must rebuild the data (augmented variants
-            // included) from the seed the run started with.
-            let start = if args.resume {
-                let resume = AnyTopResume::load(&args.out, resolved.lr, &device)?;
-                if resume.differs(&opts) {
-                    say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
-                }
-                if let Some((old, new)) = resume.shift_changes(&opts) {
-                    say(
-                        args,
-                        &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"),
-                    );
-                }
-                if let Some((old, new)) = resume.weighting_changes(&opts) {
-                    say(args, &format!("note: the checkpoint was trained with --loss-weighting {old}; it goes on learning under {new}"));
-                }
-                AnyTopStart::Resume(resume)
-            } else if let Some(init) = &args.init {
-                let init = if init.as_os_str() == "builtin" { AnyTopInit::builtin(&device)? } else { AnyTopInit::load(init, &device)? };
-                say(args, &format!("fine-tuning {} (its size and noise schedule; --preset is not used)", init.source()));
-                AnyTopStart::Init(init)
-            } else {
-                AnyTopStart::New
-            };
-            let seed = match &start {
-                AnyTopStart::Resume(r) => r.info().seed,
-                _ => opts.seed,
-            };
-            let set = training_set(args, &resolved, seed, start.dmax())?;
-            let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, &device).map_err(explain)?;
-            train(args, &resolved, trainer.first_step(), &mut trainer)
-        }
-        Arch::Sata => {
-            let mut config = args.preset.sata();
-            if let Some(crop) = args.crop {
-                config.window = crop as usize;
-                config.overlap = config.overlap.min(config.window.saturating_sub(1) / 2);
-            }
-            let opts = SataOptions {
-                config,
-                seed: args.common.seed,
-                lr: resolved.lr,
-                batch: args.batch as usize,
-                augment: resolved.augment,
-                augment_variants: args.augment_variants as usize,
-                lambda_kl: args.lambda_kl,
-                lambda_cycle: args.lambda_cycle,
-            };
-            let resume = if args.resume { Some(SataResume::load(&args.out, resolved.lr, &device)?) } else { None };
-            if resume.as_ref().is_some_and(|r| r.differs(&opts)) {
-                say(args, "note: --batch, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
-            }
-            refuse_to_overwrite(args)?;
-            if resume.is_none() {
-                opts.config.validate()?;
-            }
-            let seed = resume.as_ref().map_or(opts.seed, |r| r.info().seed);
-            let set = training_set(args, &resolved, seed, topology::DEFAULT_DMAX)?;
-            let mut trainer = SataTrainer::new(&args.out, &opts, resume, set, &device).map_err(explain)?;
-            train(args, &resolved, trainer.first_step(), &mut trainer)
-        }
+        Arch::Anytop => train_anytop(args, &resolved, &device),
+        Arch::Sata => train_sata(args, &resolved, &device),
     }?;
-    if !args.common.quiet {
-        eprintln!("mo-train: saved step {done} to {}", args.out.display());
-    }
+    say(args, &format!("saved step {done} to {}", args.out.display()));
     Ok(())
+}
+
+/// `--arch anytop`: a new, resumed or fine-tuned diffusion model; returns the steps done.
+fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Result<u64> {
+    let opts = AnyTopOptions {
+        config: args.preset.config(),
+        seed: args.common.seed,
+        lr: resolved.lr,
+        batch: args.batch as usize,
+        crop: args.crop.unwrap_or(40) as usize,
+        lambda_geo: args.lambda_geo,
+        lambda_vel: args.lambda_vel,
+        augment: resolved.augment,
+        augment_variants: args.augment_variants as usize,
+        ema: args.ema,
+        noise_shift: args.noise_shift,
+        weighting: args.loss_weighting,
+    };
+    // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.
+    refuse_to_overwrite(args)?;
+    // The checkpoint first: a resumed run must rebuild the data (augmented variants
+    // included) from the seed the run started with.
+    let start = if args.resume {
+        let resume = AnyTopResume::load(&args.out, resolved.lr, device)?;
+        if resume.differs(&opts) {
+            say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
+        }
+        if let Some((old, new)) = resume.shift_changes(&opts) {
+            say(args, &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
+        }
+        if let Some((old, new)) = resume.weighting_changes(&opts) {
+            say(args, &format!("note: the checkpoint was trained with --loss-weighting {old}; it goes on learning under {new}"));
+        }
+        AnyTopStart::Resume(resume)
+    } else if let Some(init) = &args.init {
+        let init = if init.as_os_str() == "builtin" { AnyTopInit::builtin(device)? } else { AnyTopInit::load(init, device)? };
+        say(args, &format!("fine-tuning {} (its size and noise schedule; --preset is not used)", init.source()));
+        AnyTopStart::Init(init)
+    } else {
+        AnyTopStart::New
+    };
+    let seed = match &start {
+        AnyTopStart::Resume(r) => r.info().seed,
+        _ => opts.seed,
+    };
+    let set = training_set(args, resolved, seed, start.dmax())?;
+    let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, device).map_err(explain)?;
+    train(args, resolved, trainer.first_step(), &mut trainer)
+}
+
+/// `--arch sata`: a new or resumed latent autoencoder; returns the steps done.
+fn train_sata(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Result<u64> {
+    let mut config = args.preset.sata();
+    if let Some(crop) = args.crop {
+        config.window = crop as usize;
+        config.overlap = config.overlap.min(config.window.saturating_sub(1) / 2);
+    }
+    let opts = SataOptions {
+        config,
+        seed: args.common.seed,
+        lr: resolved.lr,
+        batch: args.batch as usize,
+        augment: resolved.augment,
+        augment_variants: args.augment_variants as usize,
+        lambda_kl: args.lambda_kl,
+        lambda_cycle: args.lambda_cycle,
+    };
+    let resume = if args.resume { Some(SataResume::load(&args.out, resolved.lr, device)?) } else { None };
+    if resume.as_ref().is_some_and(|r| r.differs(&opts)) {
+        say(args, "note: --batch, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
+    }
+    refuse_to_overwrite(args)?;
+    if resume.is_none() {
+        opts.config.validate()?;
+    }
+    let seed = resume.as_ref().map_or(opts.seed, |r| r.info().seed);
+    let set = training_set(args, resolved, seed, topology::DEFAULT_DMAX)?;
+    let mut trainer = SataTrainer::new(&args.out, &opts, resume, set, device).map_err(explain)?;
+    train(args, resolved, trainer.first_step(), &mut trainer)
 }
 
 fn say(args: &Args, msg: &str) {
@@ -460,7 +461,7 @@ fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> any
     let say = |msg: String| say(args, &msg);
     let files = expand_inputs(&args.data)?;
     let loaded = load_motions(&files, &LoadOptions::default())?;
-    let clips: Vec<RawClip> = loaded.into_iter().map(|l| RawClip { name: l.name, skeleton: l.skeleton, motion: l.motion }).collect();
+    let clips = loaded;
     let names = NameTable::builtin().context("the built-in joint-name table")?;
     let augmentation = Augmentation { probability: resolved.augment, variants: args.augment_variants as usize, seed };
     let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;

@@ -7,7 +7,6 @@
 //! Errors print as one line, `tool: what went wrong: why`. A closed stdout (`| head`) is success.
 
 pub mod bounds;
-pub mod correspond;
 pub mod docs;
 pub mod latent;
 pub mod load;
@@ -21,6 +20,7 @@ pub mod mo_sample_examples;
 pub mod mo_segment;
 pub mod mo_train;
 pub mod ood;
+pub mod output;
 pub mod skel_aug;
 pub mod skel_info;
 
@@ -68,6 +68,13 @@ impl CommonOpts {
         let Some(n) = self.threads else { return Ok(()) };
         let built = BUILT.get_or_init(|| rayon::ThreadPoolBuilder::new().num_threads(n).build_global().map_err(|e| e.to_string()));
         built.clone().map_err(|e| anyhow::anyhow!("cannot start {n} worker threads: {e}"))
+    }
+}
+
+impl CommonOpts {
+    /// Messages on stderr for `tool`, as `-q` and `-v` say.
+    pub fn say(&self, tool: &'static str) -> output::Say {
+        output::Say { tool, quiet: self.quiet, verbose: self.verbose }
     }
 }
 

@@ -1,15 +1,13 @@
 //! `skel-aug`: skeletal augmentation of a BVH (motion carried over exactly) or a skeleton
 //! document.
 
-use crate::augment::{self, Plan, RemoveAmount};
+use crate::augment::{self, RemoveAmount};
 use crate::cli::CommonOpts;
 use crate::document::SkeletonDocument;
-use crate::rng::SplitMix64;
 use crate::skeleton::Skeleton;
 use crate::{bvh, io};
 use anyhow::{bail, Context};
 use std::collections::BTreeSet;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 const EXAMPLES: &str = "\
@@ -117,18 +115,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut warned = BTreeSet::new();
     let mut texts = Vec::with_capacity(outputs.len());
     for (i, out) in outputs.iter().enumerate() {
-        let mut rng = variant_rng(args.common.seed, i);
+        let mut rng = augment::variant_rng(args.common.seed, i);
         let plan = augment::plan(&skeleton, &options, &mut rng);
         let target = out.as_deref().map_or("stdout".to_string(), |p| p.display().to_string());
         if !args.common.quiet {
-            for w in warnings(&plan, &skeleton, args.add, options.keep_feet) {
+            for w in plan.shortfalls(&skeleton, args.add, options.keep_feet) {
                 if warned.insert(w.clone()) {
                     eprintln!("skel-aug: warning: {name}: {w}");
                 }
             }
         }
         if args.common.verbose {
-            eprint!("{}", describe(&plan, &name, &target));
+            eprint!("skel-aug: {}", plan.describe(&name, &target));
         }
         let text = match &input {
             Input::Bvh(b) => {
@@ -184,64 +182,6 @@ fn looks_like_json(bytes: &[u8]) -> bool {
     bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{')
 }
 
-/// Variant `i`'s generator: independent streams for every (seed, variant), and variant 0 of
-/// `-n K` is the same as a single run, whatever K.
-fn variant_rng(seed: u64, i: usize) -> SplitMix64 {
-    let a = SplitMix64::new(seed).next_u64();
-    let b = SplitMix64::new(!(i as u64)).next_u64();
-    SplitMix64::new(a ^ b)
-}
-
-/// Where a plan fell short of what was asked, in words.
-fn warnings(plan: &Plan, skeleton: &Skeleton, add: usize, keep_feet: bool) -> Vec<String> {
-    let mut out = Vec::new();
-    let n = plan.joints_before;
-    if let Some(r) = &plan.removal {
-        if r.removed.len() < r.target {
-            let why = if keep_feet {
-                "chains ending in end effectors stop at feet, branching joints and the root"
-            } else {
-                "chains stop at branching joints and the root"
-            };
-            let mut w = if r.removable == 0 {
-                format!("none of the {n} joints can be removed ({why})")
-            } else {
-                format!(
-                    "only {} of {n} joints ({:.1}%) can be removed ({why}); removing all of them, fewer than asked",
-                    r.removable,
-                    100.0 * r.removable as f64 / n as f64,
-                )
-            };
-            if keep_feet && r.removable * 10 < n && !crate::skeleton::roles::feet(skeleton).0.is_empty() {
-                w.push_str("; --allow-feet lets removal take feet (for bodies that lie on the ground)");
-            }
-            out.push(w);
-        }
-    }
-    if plan.added.len() < add {
-        out.push(format!("no bone long enough to split: added {} of {add} joints", plan.added.len()));
-    }
-    out
-}
-
-/// What a plan changed, for -v.
-fn describe(plan: &Plan, input: &str, target: &str) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "skel-aug: {input} -> {target}: {} -> {} joints", plan.joints_before, plan.skeleton.len());
-    if let Some(r) = &plan.removal {
-        let pct = 100.0 * r.removed.len() as f64 / plan.joints_before as f64;
-        let list = if r.removed.is_empty() { "nothing".to_string() } else { r.removed.join(", ") };
-        let _ = writeln!(s, "    removed {} ({pct:.1}%, asked {}): {list}", r.removed.len(), r.target);
-        if !r.new_end_effectors.is_empty() {
-            let _ = writeln!(s, "    new end effectors: {}", r.new_end_effectors.join(", "));
-        }
-    }
-    for a in &plan.added {
-        let _ = writeln!(s, "    added {} between {} and {}", a.name, a.parent, a.child);
-    }
-    s
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -252,14 +192,6 @@ mod tests {
         assert!(looks_like_json(b"\xEF\xBB\xBF{}"));
         assert!(!looks_like_json(b"HIERARCHY\n"));
         assert!(!looks_like_json(b""));
-    }
-
-    #[test]
-    fn variant_streams_differ_and_do_not_depend_on_the_count() {
-        let a: Vec<u64> = (0..4).map(|i| variant_rng(5, i).next_u64()).collect();
-        let unique: BTreeSet<u64> = a.iter().copied().collect();
-        assert_eq!(unique.len(), 4);
-        assert_ne!(variant_rng(5, 0).next_u64(), variant_rng(6, 0).next_u64());
     }
 
     #[test]

@@ -189,14 +189,14 @@ pub fn save_averaged(dir: &Path, info: &impl Serialize, varmap: &VarMap, opt: &A
 }
 
 /// A loaded checkpoint.
-pub struct Loaded {
+pub struct LoadedDenoiser {
     pub info: CheckpointInfo,
     pub varmap: VarMap,
     pub model: Denoiser,
 }
 
 /// Load `dir`'s info and model (the optimiser separately, with `load_optimizer`).
-pub fn load(dir: &Path, device: &Device) -> Result<Loaded, CheckpointError> {
+pub fn load(dir: &Path, device: &Device) -> Result<LoadedDenoiser, CheckpointError> {
     let (info, weights) = read_dir_files(dir)?;
     load_bytes(&info, &weights, device).map_err(CheckpointError::of(format!("model {}", dir.display())))
 }
@@ -234,13 +234,13 @@ fn parse_info(info_json: &[u8]) -> Result<CheckpointInfo, CheckpointError> {
 
 /// A checkpoint from the bytes of its `checkpoint.json` and `model.safetensors` (the embedded
 /// default model has no directory).
-pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<Loaded, CheckpointError> {
+pub fn load_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<LoadedDenoiser, CheckpointError> {
     let info = parse_info(info_json)?;
     let varmap = VarMap::new();
     // Build every parameter (the seed does not matter: all are overwritten), then fill them.
     let model = Denoiser::new(seeded_var_builder(&varmap, 0, device), &info.config)?;
     fill_vars(&varmap, weights, device)?;
-    Ok(Loaded { info, varmap, model })
+    Ok(LoadedDenoiser { info, varmap, model })
 }
 
 /// Overwrite every variable of `varmap` with the tensor of the same name in the safetensors
@@ -264,35 +264,35 @@ pub fn fill_vars(varmap: &VarMap, weights: &[u8], device: &Device) -> Result<(),
 /// Why: candle records every op whose inputs include a variable, so a forward pass through a
 /// trainable model keeps all its activations alive for a backward pass that sampling never
 /// runs: 240 MB per 120-frame sample of a 38-joint creature, growing with every layer.
-pub struct Frozen {
+pub struct FrozenDenoiser {
     pub info: CheckpointInfo,
     pub model: Denoiser,
 }
 
-/// `Frozen` from the bytes of `checkpoint.json` and `model.safetensors`.
-pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<Frozen, CheckpointError> {
+/// `FrozenDenoiser` from the bytes of `checkpoint.json` and `model.safetensors`.
+pub fn frozen_bytes(info_json: &[u8], weights: &[u8], device: &Device) -> Result<FrozenDenoiser, CheckpointError> {
     let info = parse_info(info_json)?;
     let tensors =
         candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
     let model = Denoiser::new(vb, &info.config).map_err(CheckpointError::Mismatch)?;
-    Ok(Frozen { info, model })
+    Ok(FrozenDenoiser { info, model })
 }
 
-/// `Frozen` from a model directory written by mo-train.
-pub fn frozen(dir: &Path, device: &Device) -> Result<Frozen, CheckpointError> {
+/// `FrozenDenoiser` from a model directory written by mo-train.
+pub fn frozen(dir: &Path, device: &Device) -> Result<FrozenDenoiser, CheckpointError> {
     let (info, weights) = read_dir_files(dir)?;
     frozen_bytes(&info, &weights, device).map_err(CheckpointError::of(format!("model {}", dir.display())))
 }
 
 /// The default model that ships inside the binaries: a `small` denoiser trained on the
 /// synthetic zoo (models/zoo-small, see its MODEL_CARD.md).
-pub fn frozen_default(device: &Device) -> Result<Frozen, CheckpointError> {
+pub fn frozen_default(device: &Device) -> Result<FrozenDenoiser, CheckpointError> {
     frozen_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))
 }
 
 /// `--model DIR`'s model, or the built-in one.
-pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<Frozen, CheckpointError> {
+pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<FrozenDenoiser, CheckpointError> {
     match dir {
         Some(dir) => frozen(dir, device),
         None => frozen_default(device),
@@ -306,7 +306,7 @@ pub const BUILTIN_WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.
 pub const BUILTIN_NAME: &str = "the built-in default model";
 
 /// The built-in model as trainable variables (a fine-tune's start, `mo-train --init builtin`).
-pub fn load_default(device: &Device) -> Result<Loaded, CheckpointError> {
+pub fn load_default(device: &Device) -> Result<LoadedDenoiser, CheckpointError> {
     load_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))
 }
 

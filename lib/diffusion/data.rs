@@ -27,7 +27,7 @@ use crate::augment::{self, RemoveAmount};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
 use crate::motion::Motion;
-use crate::repr::anytop::{self, AnyTopOptions, AnyTopStats, RestSource};
+use crate::repr::anytop::{self, AnyTopStats, RestSource, RigOptions};
 use crate::repr::Features;
 use crate::rng::SplitMix64;
 use crate::skeleton::{topology, Skeleton};
@@ -41,13 +41,7 @@ pub const MIN_FRAMES: usize = 20;
 /// fraction of the skeleton's rest extent. Re-exported rigs of one creature differ by ~1e-4
 /// (float printing); different performers or proportion variants by 1e-2 and more.
 pub const OFFSET_TOLERANCE: f64 = 1e-3;
-
-/// One clip as read from a file.
-pub struct RawClip {
-    pub name: String,
-    pub skeleton: Skeleton,
-    pub motion: Motion,
-}
+use crate::motion::Clip;
 
 /// Everything the model needs to know about one skeleton, and its clips.
 pub struct SkeletonData {
@@ -146,7 +140,7 @@ fn stem_of(name: &str) -> String {
 /// folder, else the stem its clips' file names share (`biped_long_walk`, `biped_long_run` ->
 /// `biped_long`) when no other group's files share it, else its first clip's stem; made
 /// unique with `_2`, `_3`, ...
-fn group_names(groups: &[Vec<RawClip>]) -> Vec<String> {
+fn group_names(groups: &[Vec<Clip>]) -> Vec<String> {
     let folders: Vec<Vec<String>> = groups.iter().map(|g| g.iter().map(|c| folder_of(&c.name)).collect()).collect();
     let mut names = Vec::with_capacity(groups.len());
     for (i, group) in groups.iter().enumerate() {
@@ -198,7 +192,7 @@ fn prepare<'a>(
     let (rest_name, rest_motion) = rest;
     let source =
         if anytop::names_tpose(rest_name) { RestSource::TPose { file: rest_name.to_string() } } else { RestSource::FirstClip { file: rest_name.to_string() } };
-    let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
+    let options = RigOptions { rest_source: source, ..RigOptions::default() };
     let section = AnyTopSection::new(&skeleton, &rest_motion.first_frames(2), &options)
         .map_err(|e| DataError::Clip { clip: rest_name.to_string(), why: e.to_string() })?;
     let mut features = Vec::new();
@@ -264,8 +258,8 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
 fn variants_of(
     index: usize,
     base: &SkeletonData,
-    group: &[RawClip],
-    rest: &RawClip,
+    group: &[Clip],
+    rest: &Clip,
     aug: &Augmentation,
     names: &NameTable,
     dmax: usize,
@@ -285,7 +279,7 @@ fn variants_of(
             continue;
         }
         // Only croppable clips are dealt (a T-pose file would leave its variant without any).
-        let usable: Vec<&RawClip> = group.iter().filter(|c| c.motion.frames > MIN_FRAMES + 1).collect();
+        let usable: Vec<&Clip> = group.iter().filter(|c| c.motion.frames > MIN_FRAMES + 1).collect();
         if usable.is_empty() {
             continue;
         }
@@ -315,14 +309,14 @@ fn variants_of(
 impl TrainSet {
     /// Group `clips` by skeleton and prepare them, with augmented variants as `aug` says.
     /// Clips too short to crop are dropped (returned by name, so the caller can say so).
-    pub fn build(clips: Vec<RawClip>, names: &NameTable, dmax: usize, aug: &Augmentation) -> Result<(TrainSet, Vec<String>), DataError> {
+    pub fn build(clips: Vec<Clip>, names: &NameTable, dmax: usize, aug: &Augmentation) -> Result<(TrainSet, Vec<String>), DataError> {
         if clips.is_empty() {
             return Err(DataError::Empty);
         }
         if !(0.0..=1.0).contains(&aug.probability) {
             return Err(DataError::Probability(aug.probability));
         }
-        let mut groups: Vec<Vec<RawClip>> = Vec::new();
+        let mut groups: Vec<Vec<Clip>> = Vec::new();
         for c in clips {
             match groups.iter_mut().find(|g| same_skeleton(&g[0].skeleton, &c.skeleton)) {
                 Some(g) => g.push(c),
@@ -422,13 +416,13 @@ mod tests {
     use super::*;
     use crate::synth;
 
-    fn zoo() -> Vec<RawClip> {
+    fn zoo() -> Vec<Clip> {
         ["biped", "quadruped", "spider"]
             .iter()
             .flat_map(|n| {
                 (0..2).map(move |seed| {
                     let (skeleton, motion) = synth::creature(n, seed).unwrap();
-                    RawClip { name: format!("{n}/{n}_{seed}.bvh"), skeleton, motion }
+                    Clip { name: format!("{n}/{n}_{seed}.bvh"), skeleton, motion }
                 })
             })
             .collect()
@@ -436,7 +430,7 @@ mod tests {
 
     /// The same clip twice more: once with offsets nudged far below the tolerance, once with
     /// longer legs (every offset below the root x1.2).
-    fn proportions() -> Vec<RawClip> {
+    fn proportions() -> Vec<Clip> {
         let (skeleton, motion) = synth::creature("quadruped", 0).unwrap();
         let mut nudged = skeleton.clone();
         nudged.joints.iter_mut().skip(1).for_each(|j| j.offset *= 1.0 + 1e-6);
@@ -446,9 +440,9 @@ mod tests {
         let mut long_motion = motion.clone();
         long_motion.translations.iter_mut().enumerate().filter(|(i, _)| i % long.len() != 0).for_each(|(_, t)| *t *= 1.2);
         vec![
-            RawClip { name: "zoo/quad_walk.bvh".into(), skeleton, motion: motion.clone() },
-            RawClip { name: "zoo/quad_run.bvh".into(), skeleton: nudged, motion: motion.clone() },
-            RawClip { name: "zoo/long_quad_walk.bvh".into(), skeleton: long, motion: long_motion },
+            Clip { name: "zoo/quad_walk.bvh".into(), skeleton, motion: motion.clone() },
+            Clip { name: "zoo/quad_run.bvh".into(), skeleton: nudged, motion: motion.clone() },
+            Clip { name: "zoo/long_quad_walk.bvh".into(), skeleton: long, motion: long_motion },
         ]
     }
 
@@ -458,12 +452,12 @@ mod tests {
         // A skeleton whose only clip is too short is left out, not an error.
         let mut clips = zoo();
         let (skeleton, motion) = synth::creature("crab", 0).unwrap();
-        clips.push(RawClip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) });
+        clips.push(Clip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) });
         let (set, dropped) = TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
         assert_eq!(dropped, ["crab/bind.bvh"]);
         assert!(set.skeletons.iter().all(|s| s.name != "crab"));
         let (skeleton, motion) = synth::creature("crab", 0).unwrap();
-        let short = vec![RawClip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) }];
+        let short = vec![Clip { name: "crab/bind.bvh".into(), skeleton, motion: motion.first_frames(2) }];
         assert!(matches!(TrainSet::build(short, names, topology::DEFAULT_DMAX, &Augmentation::none()), Err(DataError::TooShort { .. })));
         assert_eq!(set.skeletons.iter().map(|s| s.clips.len()).sum::<usize>(), 6);
         assert_eq!(set.variant_count(), 0);

@@ -12,6 +12,7 @@ use super::sample::{denoise, Condition, Imposed, SampleOptions};
 use super::schedule::Schedule;
 use super::DiffusionError;
 use crate::nn::Denoiser;
+use crate::repr::anytop::{AnyTopError, AnyTopRig, Placement};
 use crate::repr::Features;
 use crate::skeleton::{lookup, Skeleton};
 use candle_core::Device;
@@ -279,6 +280,46 @@ pub fn jump_distribution_of(values: Vec<f64>) -> Option<JumpDistribution> {
     all.sort_by(f64::total_cmp);
     let at = |q: f64| all[((all.len() - 1) as f64 * q).round() as usize];
     Some(JumpDistribution { boundaries: all.len(), median: at(0.5), p95: at(0.95), max: all[all.len() - 1] })
+}
+
+/// `mo-sample --report`: the seam jumps of each edited sample against the reference clip's own
+/// jump distribution, and the jumps inside the generated stretch, as one JSON value.
+/// `reference` is the clip's name, features and placement.
+pub fn seam_report(
+    rig: &AnyTopRig,
+    skeleton: &Skeleton,
+    reference: (&str, &Features, &Placement),
+    mask: &KeepMask,
+    samples: &[Features],
+) -> Result<serde_json::Value, AnyTopError> {
+    let (name, features, placement) = reference;
+    let j = skeleton.len();
+    let positions = |f: &Features| rig.recover_positions(skeleton, f, placement);
+    let reference = positions(features)?;
+    let distribution = jump_distribution([(reference.as_slice(), j)]);
+    let kept = mask.whole_frames();
+    let mut rows = Vec::with_capacity(samples.len());
+    for f in samples {
+        let p = positions(f)?;
+        let seams = seam_jump(&p, j, &kept);
+        let max = seams.iter().map(|s| s.jump).fold(0.0, f64::max);
+        // The same number inside the generated stretch (boundaries between two generated
+        // frames): a seam as smooth as the model's own motion matches it.
+        let jumps = boundary_jumps(&p, j);
+        let inside: Vec<f64> = (1..kept.len()).filter(|&b| !kept[b] && !kept[b - 1]).filter_map(|b| jumps.get(b - 1).copied()).collect();
+        let generated = jump_distribution_of(inside);
+        rows.push(serde_json::json!({ "seams": seams, "max_seam_jump": max, "generated_jumps": generated }));
+    }
+    let report = serde_json::json!({
+        "report": "seam_jump",
+        "units": "BVH units per frame",
+        "reference": name,
+        "kept_frames": kept.iter().filter(|&&k| k).count(),
+        "kept_cells": mask.count(),
+        "reference_jumps": distribution,
+        "samples": rows,
+    });
+    Ok(report)
 }
 
 #[cfg(test)]

@@ -741,14 +741,15 @@ pub fn rotation_distance(a: &Tensor, b: &Tensor) -> candle_core::Result<Tensor> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diffusion::data::{Augmentation, RawClip};
+    use crate::diffusion::data::Augmentation;
     use crate::embed::NameTable;
+    use crate::motion::Clip;
     use crate::nn::{seeded_var_builder, DenoiserConfig};
     use crate::skeleton::topology;
 
     fn set() -> TrainSet {
         let (skeleton, motion) = crate::synth::creature("quadruped", 0).unwrap();
-        let clips = vec![RawClip { name: "q.bvh".into(), skeleton, motion }];
+        let clips = vec![Clip { name: "q.bvh".into(), skeleton, motion }];
         // Augmented: the resume test then also covers variant draws.
         TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &Augmentation::with_seed(2)).unwrap().0
     }
@@ -901,7 +902,7 @@ mod tests {
     #[test]
     fn splitting_a_skeletons_crops_into_sub_batches_changes_neither_loss_nor_gradient() {
         let (skeleton, motion) = crate::synth::creature("quadruped", 1).unwrap();
-        let clips = vec![RawClip { name: "q.bvh".into(), skeleton, motion }];
+        let clips = vec![Clip { name: "q.bvh".into(), skeleton, motion }];
         let set = TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &Augmentation::none()).unwrap().0;
         let schedule = Schedule::cosine(100);
         // One skeleton, more crops than a sub-batch takes: the step splits it.

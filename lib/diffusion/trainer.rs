@@ -289,7 +289,7 @@ impl AnyTopStart {
 
 /// A model whose weights start a new run.
 pub struct AnyTopInit {
-    loaded: checkpoint::Loaded,
+    loaded: checkpoint::LoadedDenoiser,
     /// How the checkpoint names it: "the built-in default model (step N)", "model DIR (step N)".
     source: String,
 }
@@ -320,7 +320,7 @@ impl AnyTopInit {
 
 /// A denoiser checkpoint to continue, with its optimiser state.
 pub struct AnyTopResume {
-    loaded: checkpoint::Loaded,
+    loaded: checkpoint::LoadedDenoiser,
     opt: AdamW,
     /// The raw weights of an averaged checkpoint (its `model.safetensors` holds the average).
     raw: std::collections::HashMap<String, candle_core::Tensor>,

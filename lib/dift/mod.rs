@@ -174,7 +174,7 @@ pub fn centred(mut rows: Vec<Vec<f32>>) -> Vec<Vec<f32>> {
 }
 
 /// A motion ready for the denoiser: its condition, and its AnyTop features normalised.
-pub struct Prepared {
+pub struct PreparedMotion {
     pub condition: SkeletonCondition,
     /// Normalised `[frames − 1, joints, 13]` (AnyTop features drop a BVH's last frame).
     pub features: Features,
@@ -187,7 +187,7 @@ pub struct Prepared {
 /// other by its own shifts all of its features alike, so a few reference joints become
 /// everyone's best match (measured: a quadruped against its own skel-aug variant, 5 of 21
 /// joints right with the training statistics for the original, 21 of 21 with each clip's own).
-pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file: &str) -> Result<Prepared, DiftError> {
+pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file: &str) -> Result<PreparedMotion, DiftError> {
     if motion.frames < 2 {
         return Err(DiftError::Invalid(format!("{file}: {} frame(s); DIFT features need a motion of at least 2 frames", motion.frames)));
     }
@@ -199,12 +199,18 @@ pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file
 
 /// `prepare` for a motion already encoded (physical AnyTop features) with a rig whose P_S is
 /// `rest_row`, e.g. an NPY from `mo-encode` and its skeleton document.
-pub fn prepare_encoded(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], mut features: Features, file: &str) -> Result<Prepared, DiftError> {
+pub fn prepare_encoded(
+    info: &CheckpointInfo,
+    skeleton: &Skeleton,
+    rest_row: &[Vec<f32>],
+    mut features: Features,
+    file: &str,
+) -> Result<PreparedMotion, DiftError> {
     let measured = AnyTopStats::compute([&features]).map_err(DiftError::repr(file))?;
     let condition = SkeletonCondition::with_stats(info, skeleton, rest_row, measured, StatsSource::Measured)
         .map_err(|source| DiftError::Condition { file: file.to_string(), source })?;
     condition.stats.normalise(&mut features).map_err(DiftError::repr(file))?;
-    Ok(Prepared { condition, features })
+    Ok(PreparedMotion { condition, features })
 }
 
 /// Draws place the clip at a temporal position below this (training crops start anywhere in
@@ -214,7 +220,7 @@ const MAX_START: usize = 256;
 /// Tokens (frames x joints x draws) per forward pass: bounds memory on long clips.
 const TOKENS_PER_PASS: usize = 48_000;
 
-/// DIFT features of a normalised motion (`Prepared::features`): the mean over `opts.draws`
+/// DIFT features of a normalised motion (`PreparedMotion::features`): the mean over `opts.draws`
 /// noise draws of the activations after `opts.layer` at step `opts.t`. Deterministic for
 /// `opts.seed`; draw k always takes the same noise whatever the batching.
 pub fn extract(

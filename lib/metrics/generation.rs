@@ -17,7 +17,7 @@
 //!
 //! Definitions, units and deviations from the reference: `docs/metrics.md`.
 
-use super::{Clip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::repr::anytop::{Facing, HUMANML_MEAN_BONE_LENGTH};
 use crate::rng::SplitMix64;
 use glam::{DQuat, DVec3};
@@ -87,7 +87,7 @@ impl PointClip {
 
     /// The reference's features from world positions, with the default [`PointFeatures`]
     /// (world axes, scale from the clip's own bones).
-    pub fn from_clip(clip: &Clip) -> Result<PointClip, MetricError> {
+    pub fn from_clip(clip: &WorldClip) -> Result<PointClip, MetricError> {
         PointClip::from_clip_with(clip, &PointFeatures::default())
     }
 
@@ -96,7 +96,7 @@ impl PointClip {
     /// face +Z (identity without a facing rule; a degenerate frame keeps the previous yaw)
     /// and `s` the scale to AnyTop units. This equals the reference's RIC position with the
     /// root height subtracted.
-    pub fn from_clip_with(clip: &Clip, features: &PointFeatures) -> Result<PointClip, MetricError> {
+    pub fn from_clip_with(clip: &WorldClip, features: &PointFeatures) -> Result<PointClip, MetricError> {
         if clip.positions.len() != clip.frames * clip.joints {
             return Err(MetricError::Mismatch(format!("clip: {} positions for {} frames × {} joints", clip.positions.len(), clip.frames, clip.joints)));
         }

@@ -155,7 +155,7 @@ fn bad_and_tiny_inputs_are_typed_errors() {
     assert_eq!(r.coverage.mean, 100.0);
 }
 
-fn chain_clip(frames: usize, turn: f64) -> Clip {
+fn chain_clip(frames: usize, turn: f64) -> WorldClip {
     // Root at height 1 walking along +x; a 2-bone neck of length 1 and 2 leaning forward
     // (+x) and up; a body axis from joint 2 (front) to joint 0 (back); `turn` rotates the
     // whole clip about y.
@@ -167,7 +167,7 @@ fn chain_clip(frames: usize, turn: f64) -> Clip {
         let j2 = j1 + DVec3::new(2.0, 0.0, 0.0);
         positions.extend([q * root, q * j1, q * j2]);
     }
-    Clip {
+    WorldClip {
         frames,
         joints: 3,
         fps: 30.0,

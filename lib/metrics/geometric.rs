@@ -12,7 +12,7 @@
 //! false instead of NaN.
 
 use super::physics::{check_clip, joint_name};
-use super::{Clip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::skeleton::names::{self, Side};
 use glam::DVec3;
 
@@ -60,7 +60,7 @@ const SEARCH_DEPTH: usize = 2;
 /// legs and arms branch, the belly as the first joint above the pelvis towards the chest, the
 /// neck by name (else the parent of the head). Sides come from names, inherited by unnamed
 /// descendants. `Err` says which role is missing.
-pub fn human_roles(clip: &Clip) -> Result<HumanRoles, String> {
+pub fn human_roles(clip: &WorldClip) -> Result<HumanRoles, String> {
     let n = clip.joints;
     if clip.parents.len() != n || clip.names.len() != n {
         return Err(format!("the clip has {n} joints but {} parents and {} names", clip.parents.len(), clip.names.len()));
@@ -385,7 +385,7 @@ impl HumanRoles {
 }
 
 /// The body lengths `opts` asks for (measured on the clip, or given).
-pub fn body_lengths(clip: &Clip, roles: &HumanRoles, opts: &GeometricOptions) -> Lengths {
+pub fn body_lengths(clip: &WorldClip, roles: &HumanRoles, opts: &GeometricOptions) -> Lengths {
     match opts.lengths {
         BodyLengths::Fixed { humerus, shoulder_width, hip_width } => Lengths { humerus, shoulder_width, hip_width },
         BodyLengths::Measured => {
@@ -409,7 +409,7 @@ fn unit(v: DVec3) -> Option<DVec3> {
 /// The 32 feature values, each the fraction of frames 1..T-1 on which the relation holds
 /// (velocities from frame f-1 to f). Needs 2 frames, finite input, roles inside the clip and
 /// body lengths that are positive.
-pub fn geometric_features(clip: &Clip, roles: &HumanRoles, opts: &GeometricOptions) -> Result<Vec<f64>, MetricError> {
+pub fn geometric_features(clip: &WorldClip, roles: &HumanRoles, opts: &GeometricOptions) -> Result<Vec<f64>, MetricError> {
     check_clip(clip, 2, "geometric features")?;
     if let Some(j) = roles.all().into_iter().find(|&j| j >= clip.joints) {
         return Err(MetricError::Mismatch(format!("geometric features: role joint {j} is outside the clip's {} joints", clip.joints)));
@@ -479,7 +479,7 @@ mod tests {
 
     /// A small human in the SMPL layout (y up, facing +z, left at +x), Mixamo-style names.
     /// Returns the clip (one frame per pose) and the expected roles by name.
-    pub(crate) fn human(poses: &[Vec<DVec3>], fps: f64) -> Clip {
+    pub(crate) fn human(poses: &[Vec<DVec3>], fps: f64) -> WorldClip {
         let joints = skeleton_joints();
         let n = joints.len();
         let mut positions = Vec::new();
@@ -487,7 +487,7 @@ mod tests {
             assert_eq!(p.len(), n);
             positions.extend_from_slice(p);
         }
-        Clip {
+        WorldClip {
             frames: poses.len(),
             joints: n,
             fps,

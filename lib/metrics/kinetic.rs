@@ -8,7 +8,7 @@
 //! to f32); clips shorter than 3 frames are refused instead of giving zero energy expenditure.
 
 use super::physics::check_clip;
-use super::{Clip, MetricError};
+use super::{MetricError, WorldClip};
 use glam::DVec3;
 
 /// Half-width of the smoothing window, in frames (the reference's `sliding_window = 2`).
@@ -23,7 +23,7 @@ const WINDOW: isize = 2;
 ///   units / s²); a frame whose window holds no second difference contributes 0.
 ///
 /// Needs 3 frames (the first frame that has an acceleration) and finite input.
-pub fn kinetic_features(clip: &Clip) -> Result<Vec<f64>, MetricError> {
+pub fn kinetic_features(clip: &WorldClip) -> Result<Vec<f64>, MetricError> {
     check_clip(clip, 3, "kinetic features")?;
     let dt = 1.0 / clip.fps;
     let t = clip.frames as isize;
@@ -62,7 +62,7 @@ pub fn kinetic_features(clip: &Clip) -> Result<Vec<f64>, MetricError> {
 }
 
 /// Names of the `kinetic_features` dimensions, `<joint>/h`, `<joint>/v`, `<joint>/e`.
-pub fn kinetic_feature_names(clip: &Clip) -> Vec<String> {
+pub fn kinetic_feature_names(clip: &WorldClip) -> Vec<String> {
     (0..clip.joints)
         .flat_map(|j| {
             let name = super::physics::joint_name(clip, j);

@@ -1,7 +1,7 @@
 //! Evaluation metrics of the three papers (AnyTop, Motion2Motion, SATA) and physical
 //! plausibility scores for any motion. Definitions, sources and deviations: `docs/metrics.md`.
 //!
-//! Everything here works on world-space joint positions ([`Clip`]) or per-frame point sets,
+//! Everything here works on world-space joint positions ([`WorldClip`]) or per-frame point sets,
 //! never on files: `mo-metrics` loads BVH or NPY + skeleton, runs our FK, and hands clips over.
 //! Every function returns a defined value or a [`MetricError`]; none panics or returns NaN on
 //! finite input, and inputs are checked for non-finite values first.
@@ -13,13 +13,14 @@ pub mod kinetic;
 pub mod movement;
 pub mod physics;
 pub mod reconstruction;
+pub mod report;
 pub mod transfer;
 
 use glam::DVec3;
 
 /// One motion as world positions (y up), with what metrics need to know about its skeleton.
 #[derive(Clone, Debug)]
-pub struct Clip {
+pub struct WorldClip {
     pub frames: usize,
     pub joints: usize,
     /// Frames per second.
@@ -38,7 +39,7 @@ pub struct Clip {
     pub scale: f64,
 }
 
-impl Clip {
+impl WorldClip {
     /// The joints of frame `f`.
     pub fn frame(&self, f: usize) -> &[DVec3] {
         &self.positions[f * self.joints..(f + 1) * self.joints]
@@ -53,9 +54,9 @@ impl Clip {
     /// `skeleton::roles::feet`, scale `Skeleton::rest_extent`, fps `1 / frame_time` (a zero or
     /// negative frame time gives a non-finite or negative fps, which every metric refuses).
     /// `motion` must be on `skeleton` (as every loader in `cli::load` returns them).
-    pub fn from_motion(skeleton: &crate::skeleton::Skeleton, motion: &crate::motion::Motion) -> Clip {
+    pub fn from_motion(skeleton: &crate::skeleton::Skeleton, motion: &crate::motion::Motion) -> WorldClip {
         let pose = motion.forward_kinematics(skeleton);
-        Clip {
+        WorldClip {
             frames: pose.frames,
             joints: pose.joints,
             fps: 1.0 / motion.frame_time,

@@ -26,7 +26,7 @@
 
 use super::generation::PointClip;
 use super::physics::{contacts, Ground, PhysicsOptions};
-use super::{Clip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::rng::SplitMix64;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -85,7 +85,7 @@ pub struct Movement {
 /// A skeleton's clips, prepared once: world clips for energy, contact and poses, AnyTop point
 /// clips for windows, and the calibrated threshold.
 pub struct Reference<'a> {
-    clips: &'a [Clip],
+    clips: &'a [WorldClip],
     points: &'a [PointClip],
     energy: f64,
     /// Pose descriptors of the (strided) reference frames, and which clip each came from.
@@ -123,7 +123,7 @@ fn descriptor_distance(a: &[f64], b: &[f64]) -> f64 {
 
 /// Mean speed of the joints relative to the root (joint 0, which counts as a still joint),
 /// in sizes per second, after a `smooth`-frame moving average. 0 for clips too short to move.
-pub fn energy(clip: &Clip, smooth: usize) -> f64 {
+pub fn energy(clip: &WorldClip, smooth: usize) -> f64 {
     let k = smooth.max(1);
     let (frames, joints) = (clip.frames, clip.joints);
     if frames < k + 1 || joints == 0 || !(clip.scale > 0.0) || !clip.fps.is_finite() {
@@ -144,7 +144,7 @@ pub fn energy(clip: &Clip, smooth: usize) -> f64 {
 
 /// Foot-contact statistics of one clip: (duty factor, mixed-contact share), `None` where the
 /// skeleton has no feet (or fewer than two, for the second).
-pub fn contact_stats(clip: &Clip, opts: &PhysicsOptions) -> (Option<f64>, Option<f64>) {
+pub fn contact_stats(clip: &WorldClip, opts: &PhysicsOptions) -> (Option<f64>, Option<f64>) {
     if clip.feet.is_empty() || clip.frames == 0 {
         return (None, None);
     }
@@ -193,7 +193,7 @@ impl<'a> Reference<'a> {
     /// Prepare one skeleton's clips: `clips` in world space and `points` the same clips as
     /// AnyTop point clips (same order). Errors when no clip is long enough for a window, or
     /// the two lists differ.
-    pub fn new(clips: &'a [Clip], points: &'a [PointClip], opts: &MovementOptions) -> Result<Reference<'a>, MetricError> {
+    pub fn new(clips: &'a [WorldClip], points: &'a [PointClip], opts: &MovementOptions) -> Result<Reference<'a>, MetricError> {
         if clips.len() != points.len() || clips.is_empty() {
             return Err(MetricError::Mismatch(format!("movement: {} clips and {} point clips", clips.len(), points.len())));
         }
@@ -255,7 +255,7 @@ impl<'a> Reference<'a> {
 
     /// Mean over the frames of `clip` of the distance to the nearest reference frame, leaving
     /// out reference frames of clip `skip` (for leave-one-out baselines).
-    fn nearest_pose(&self, clip: &Clip, skip: Option<usize>) -> f64 {
+    fn nearest_pose(&self, clip: &WorldClip, skip: Option<usize>) -> f64 {
         let frames: Vec<Vec<f64>> = (0..clip.frames).map(|f| pose_descriptor(clip.frame(f), clip.scale)).collect();
         let best: Vec<f64> = frames
             .par_iter()
@@ -292,7 +292,7 @@ impl<'a> Reference<'a> {
 
     /// Score `motions` (world clips and the same as point clips, in one order) against the
     /// clips. `skip` leaves one clip out of every comparison (the clips' own baseline).
-    pub fn score(&self, motions: &[Clip], points: &[PointClip], skip: Option<usize>) -> Result<Movement, MetricError> {
+    pub fn score(&self, motions: &[WorldClip], points: &[PointClip], skip: Option<usize>) -> Result<Movement, MetricError> {
         if motions.is_empty() || motions.len() != points.len() {
             return Err(MetricError::Mismatch(format!("movement: {} motions and {} point clips", motions.len(), points.len())));
         }
@@ -375,7 +375,7 @@ impl<'a> Reference<'a> {
     /// `count` static clips of `frames` frames holding the clips' mean pose (root-relative
     /// positions averaged over every frame, the root where the first clip starts), as world and
     /// point clips.
-    pub fn mean_pose(&self, count: usize, frames: usize) -> (Vec<Clip>, Vec<PointClip>) {
+    pub fn mean_pose(&self, count: usize, frames: usize) -> (Vec<WorldClip>, Vec<PointClip>) {
         let first = &self.clips[0];
         let joints = first.joints;
         let mut sum = vec![DVec3::ZERO; joints];
@@ -394,7 +394,7 @@ impl<'a> Reference<'a> {
         let heights: Vec<f64> = self.clips.iter().flat_map(|c| (0..c.frames).map(move |f| c.at(f, 0).y)).collect();
         let root = DVec3::new(first.at(0, 0).x, heights.iter().sum::<f64>() / heights.len().max(1) as f64, first.at(0, 0).z);
         let pose: Vec<DVec3> = sum.iter().map(|s| root + *s / n.max(1) as f64).collect();
-        let clip = Clip { frames, positions: (0..frames).flat_map(|_| pose.iter().copied()).collect(), ..first.clone() };
+        let clip = WorldClip { frames, positions: (0..frames).flat_map(|_| pose.iter().copied()).collect(), ..first.clone() };
         let dims = self.points[0].dims();
         let mut mean = vec![0.0; dims];
         let mut m = 0usize;
@@ -416,7 +416,7 @@ impl<'a> Reference<'a> {
     /// random places of the clips, as world and point clips. The crops take the clips in turn,
     /// at least two from each: a handful of crops drawn from clips at random can all land in
     /// the idle clip, and the baseline would then say that real motion barely moves.
-    pub fn random_crops(&self, count: usize, frames: usize, seed: u64) -> (Vec<Clip>, Vec<PointClip>) {
+    pub fn random_crops(&self, count: usize, frames: usize, seed: u64) -> (Vec<WorldClip>, Vec<PointClip>) {
         let mut rng = SplitMix64::new(seed);
         let count = count.max(2 * self.clips.len());
         let mut world = Vec::with_capacity(count);
@@ -427,7 +427,7 @@ impl<'a> Reference<'a> {
             let len = frames.min(clip.frames).min(point.frames());
             let start = rng.below(clip.frames.min(point.frames()) - len + 1);
             let joints = clip.joints;
-            world.push(Clip { frames: len, positions: clip.positions[start * joints..(start + len) * joints].to_vec(), ..clip.clone() });
+            world.push(WorldClip { frames: len, positions: clip.positions[start * joints..(start + len) * joints].to_vec(), ..clip.clone() });
             let dims = point.dims();
             points
                 .push(PointClip::new(len, dims, point.values()[start * dims..(start + len) * dims].to_vec()).expect("a crop of a point clip is a point clip"));
@@ -441,18 +441,18 @@ mod tests {
     use super::*;
 
     /// A synthetic quadruped's walk as world and point clips.
-    fn walk() -> (Clip, PointClip) {
+    fn walk() -> (WorldClip, PointClip) {
         let (skeleton, motion) = crate::synth::creature("quadruped", 3).unwrap();
-        let clip = Clip::from_motion(&skeleton, &motion);
+        let clip = WorldClip::from_motion(&skeleton, &motion);
         let points = PointClip::from_clip(&clip).unwrap();
         (clip, points)
     }
 
     /// Every `k`-th frame at the same frame rate: the same motion played `k` times as fast.
-    fn faster(clip: &Clip, k: usize) -> Clip {
+    fn faster(clip: &WorldClip, k: usize) -> WorldClip {
         let frames: Vec<usize> = (0..clip.frames).step_by(k).collect();
         let positions = frames.iter().flat_map(|&f| clip.frame(f).iter().copied()).collect();
-        Clip { frames: frames.len(), positions, ..clip.clone() }
+        WorldClip { frames: frames.len(), positions, ..clip.clone() }
     }
 
     #[test]
@@ -486,14 +486,23 @@ mod tests {
     }
 
     /// A hip that stays put and a foot swinging under it at `hz`, 30 fps.
-    fn swing(frames: usize, hz: f64) -> Clip {
+    fn swing(frames: usize, hz: f64) -> WorldClip {
         let positions = (0..frames)
             .flat_map(|f| {
                 let x = 0.3 * (std::f64::consts::TAU * hz * f as f64 / 30.0).sin();
                 [DVec3::Y, DVec3::new(x, 0.0, 0.0)]
             })
             .collect();
-        Clip { frames, joints: 2, fps: 30.0, positions, parents: vec![None, Some(0)], names: vec!["Hips".into(), "LeftFoot".into()], feet: vec![1], scale: 1.0 }
+        WorldClip {
+            frames,
+            joints: 2,
+            fps: 30.0,
+            positions,
+            parents: vec![None, Some(0)],
+            names: vec!["Hips".into(), "LeftFoot".into()],
+            feet: vec![1],
+            scale: 1.0,
+        }
     }
 
     #[test]
@@ -535,7 +544,7 @@ mod tests {
     #[test]
     fn too_short_clips_are_an_error() {
         let (clip, _) = walk();
-        let short = Clip { frames: 10, positions: clip.positions[..10 * clip.joints].to_vec(), ..clip };
+        let short = WorldClip { frames: 10, positions: clip.positions[..10 * clip.joints].to_vec(), ..clip };
         let points = PointClip::from_clip(&short).unwrap();
         assert!(matches!(Reference::new(&[short], &[points], &MovementOptions::default()), Err(MetricError::TooLittle(_))));
     }

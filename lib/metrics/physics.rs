@@ -2,11 +2,11 @@
 //! penetration, floating and jitter, plus the foot contacts the transfer metrics compare.
 //! Definitions, units and deviations: `docs/metrics.md`.
 //!
-//! Every threshold is a fraction of the skeleton's size (`Clip::scale`), so a mouse and a
+//! Every threshold is a fraction of the skeleton's size (`WorldClip::scale`), so a mouse and a
 //! dinosaur are judged alike; every distance is reported in clip units and divided by the
 //! scale (`Measure::normalised`).
 
-use super::{Clip, MetricError};
+use super::{MetricError, WorldClip};
 use glam::DVec3;
 use serde::ser::SerializeMap;
 
@@ -24,7 +24,7 @@ pub enum Ground {
     Estimate,
 }
 
-/// Thresholds of contact, as fractions of `Clip::scale`.
+/// Thresholds of contact, as fractions of `WorldClip::scale`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct PhysicsOptions {
     /// A foot joint this close to the ground (fraction of the scale) is on it.
@@ -146,7 +146,7 @@ pub struct PhysicsReport {
 
 /// Check what every metric relies on: enough frames, consistent sizes, a positive finite fps
 /// and scale, finite positions. `what` names the metric in messages.
-pub fn check_clip(clip: &Clip, min_frames: usize, what: &str) -> Result<(), MetricError> {
+pub fn check_clip(clip: &WorldClip, min_frames: usize, what: &str) -> Result<(), MetricError> {
     if clip.joints == 0 {
         return Err(MetricError::TooLittle(format!("{what}: the clip has no joints")));
     }
@@ -191,7 +191,7 @@ pub fn check_clip(clip: &Clip, min_frames: usize, what: &str) -> Result<(), Metr
 }
 
 /// A joint's name for messages (clips built by hand may have no names).
-pub fn joint_name(clip: &Clip, j: usize) -> String {
+pub fn joint_name(clip: &WorldClip, j: usize) -> String {
     clip.names.get(j).cloned().unwrap_or_else(|| format!("joint {j}"))
 }
 
@@ -212,7 +212,7 @@ fn check_options(opts: &PhysicsOptions) -> Result<(), MetricError> {
 }
 
 /// The y of the ground plane for this clip (the clip must have passed `check_clip`).
-pub fn ground_height(clip: &Clip, ground: Ground) -> f64 {
+pub fn ground_height(clip: &WorldClip, ground: Ground) -> f64 {
     match ground {
         Ground::Zero => 0.0,
         Ground::Height(h) => h,
@@ -233,7 +233,7 @@ pub fn ground_height(clip: &Clip, ground: Ground) -> f64 {
 /// within `contact_height x scale` of the ground and moves slower than `contact_speed x scale`
 /// per second (speed from the previous frame; frame 0 uses the next one). A clip that fails
 /// `check_clip` (or a one-frame clip, for speed) gives all-false rows rather than a panic.
-pub fn contacts(clip: &Clip, opts: &PhysicsOptions) -> Vec<Vec<bool>> {
+pub fn contacts(clip: &WorldClip, opts: &PhysicsOptions) -> Vec<Vec<bool>> {
     if check_clip(clip, 2, "contacts").is_err() || check_options(opts).is_err() {
         return vec![vec![false; clip.frames]; clip.feet.len()];
     }
@@ -261,7 +261,7 @@ fn horizontal(v: DVec3) -> f64 {
 /// Score one motion; errors on non-finite input. A single frame (a rest pose) still has
 /// penetration and floating; contacts and skating need 2 frames and jitter 4, and are
 /// `NotApplicable` (with the reason) below that.
-pub fn physics(clip: &Clip, opts: &PhysicsOptions) -> Result<PhysicsReport, MetricError> {
+pub fn physics(clip: &WorldClip, opts: &PhysicsOptions) -> Result<PhysicsReport, MetricError> {
     check_clip(clip, 1, "physics")?;
     check_options(opts)?;
     let (frames, fps, scale) = (clip.frames, clip.fps, clip.scale);
@@ -373,13 +373,13 @@ pub(crate) mod tests {
     use super::*;
 
     /// A two-joint clip: a hip above a foot, at `fps`, the foot at `foot(f)`, the hip 1 above.
-    pub(crate) fn biped(frames: usize, fps: f64, foot: impl Fn(usize) -> DVec3) -> Clip {
+    pub(crate) fn biped(frames: usize, fps: f64, foot: impl Fn(usize) -> DVec3) -> WorldClip {
         let mut positions = Vec::new();
         for f in 0..frames {
             positions.push(foot(f) + DVec3::Y);
             positions.push(foot(f));
         }
-        Clip { frames, joints: 2, fps, positions, parents: vec![None, Some(0)], names: vec!["Hips".into(), "LeftFoot".into()], feet: vec![1], scale: 1.0 }
+        WorldClip { frames, joints: 2, fps, positions, parents: vec![None, Some(0)], names: vec!["Hips".into(), "LeftFoot".into()], feet: vec![1], scale: 1.0 }
     }
 
     #[test]
@@ -397,7 +397,7 @@ pub(crate) mod tests {
     fn sliding_foot_skates_at_its_speed() {
         // 0.3 units per second along x, at ground level: skating 0.3, and faster than the
         // 0.5 x 0.5 = 0.25 contact speed on every step, so no contact.
-        let clip = Clip { scale: 0.5, ..biped(31, 30.0, |f| DVec3::new(0.01 * f as f64, 0.0, 0.0)) };
+        let clip = WorldClip { scale: 0.5, ..biped(31, 30.0, |f| DVec3::new(0.01 * f as f64, 0.0, 0.0)) };
         let r = physics(&clip, &PhysicsOptions::default()).unwrap();
         let s = r.foot_skating.value().unwrap();
         assert!((s.value - 0.3).abs() < 1e-12, "{s:?}");
@@ -439,7 +439,7 @@ pub(crate) mod tests {
 
     #[test]
     fn no_feet_is_not_applicable_and_serialises_with_the_reason() {
-        let clip = Clip { feet: vec![], ..biped(5, 30.0, |_| DVec3::ZERO) };
+        let clip = WorldClip { feet: vec![], ..biped(5, 30.0, |_| DVec3::ZERO) };
         let r = physics(&clip, &PhysicsOptions::default()).unwrap();
         assert!(matches!(r.foot_skating, Maybe::NotApplicable(_)));
         let json = serde_json::to_value(&r).unwrap();
@@ -460,8 +460,8 @@ pub(crate) mod tests {
         nan.positions[5].y = f64::NAN;
         let e = physics(&nan, &opts).unwrap_err();
         assert!(matches!(&e, MetricError::NonFinite(m) if m.contains("frame 2, joint 1 'LeftFoot'")), "{e}");
-        assert!(matches!(physics(&Clip { fps: 0.0, ..biped(6, 30.0, |_| DVec3::ZERO) }, &opts), Err(MetricError::NonFinite(_))));
-        let short = Clip { frames: 7, ..biped(6, 30.0, |_| DVec3::ZERO) };
+        assert!(matches!(physics(&WorldClip { fps: 0.0, ..biped(6, 30.0, |_| DVec3::ZERO) }, &opts), Err(MetricError::NonFinite(_))));
+        let short = WorldClip { frames: 7, ..biped(6, 30.0, |_| DVec3::ZERO) };
         assert!(matches!(physics(&short, &opts), Err(MetricError::Mismatch(_))));
         assert_eq!(contacts(&short, &opts), vec![vec![false; 7]]);
         assert!(physics(&biped(6, 30.0, |_| DVec3::ZERO), &PhysicsOptions { ground: Ground::Height(f64::NAN), ..opts }).is_err());

@@ -4,7 +4,7 @@
 //! `docs/metrics.md`.
 
 use super::physics::{self, check_clip, Maybe, Measure, PhysicsOptions};
-use super::{Clip, MetricError};
+use super::{MetricError, WorldClip};
 use crate::skeleton::Skeleton;
 use glam::DQuat;
 
@@ -115,8 +115,8 @@ fn check_rotations(r: &Rotations, frames: usize, joints: usize) -> Result<(), Me
 /// have the same joints, frames and frame rate (within 0.1%); `height` must be positive and
 /// finite. One frame is a pose reconstruction: FS is then `NotApplicable`.
 pub fn reconstruction(
-    reference: &Clip,
-    result: &Clip,
+    reference: &WorldClip,
+    result: &WorldClip,
     rotations: Option<&Rotations>,
     height: f64,
     opts: &PhysicsOptions,
@@ -191,7 +191,7 @@ mod tests {
     use crate::metrics::physics::tests::biped;
     use glam::DVec3;
 
-    fn walk(frames: usize) -> Clip {
+    fn walk(frames: usize) -> WorldClip {
         biped(frames, 30.0, |f| DVec3::new(0.1 * f as f64, 0.0, 0.02 * (f as f64).sin()))
     }
 
@@ -240,7 +240,7 @@ mod tests {
         let short = vec![DQuat::IDENTITY; 3];
         let rot = Rotations { reference: &short, result: &short, counted: vec![0] };
         assert!(matches!(reconstruction(&walk(6), &walk(6), Some(&rot), 1.0, &opts), Err(MetricError::Mismatch(_))));
-        let other_fps = Clip { fps: 60.0, ..walk(6) };
+        let other_fps = WorldClip { fps: 60.0, ..walk(6) };
         assert!(matches!(reconstruction(&walk(6), &other_fps, None, 1.0, &opts), Err(MetricError::Mismatch(_))));
     }
 }

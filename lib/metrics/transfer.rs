@@ -4,7 +4,7 @@
 //! ours; `docs/metrics.md` states each choice.
 
 use super::physics::{self, check_clip, Maybe, Measure, PhysicsOptions};
-use super::{Clip, MetricError};
+use super::{MetricError, WorldClip};
 use glam::DVec3;
 
 /// Frequency alignment: mean over joint pairs of the cosine similarity of the power spectral
@@ -33,7 +33,7 @@ pub struct ContactConsistency {
     pub frames: usize,
 }
 
-fn check_pairs(source: &Clip, result: &Clip, pairs: &[(usize, usize)], what: &str) -> Result<(), MetricError> {
+fn check_pairs(source: &WorldClip, result: &WorldClip, pairs: &[(usize, usize)], what: &str) -> Result<(), MetricError> {
     if pairs.is_empty() {
         return Err(MetricError::TooLittle(format!("{what} needs at least one (source joint, result joint) pair")));
     }
@@ -48,7 +48,7 @@ fn check_pairs(source: &Clip, result: &Clip, pairs: &[(usize, usize)], what: &st
 
 /// Velocities of joint `j` (one per frame step, clip units per second), minus their mean:
 /// the mean velocity is the 0 Hz bin (steady locomotion), which says nothing about timing.
-fn velocities(clip: &Clip, j: usize) -> Vec<DVec3> {
+fn velocities(clip: &WorldClip, j: usize) -> Vec<DVec3> {
     let v: Vec<DVec3> = (1..clip.frames).map(|f| (clip.at(f, j) - clip.at(f - 1, j)) * clip.fps).collect();
     let mean = v.iter().copied().sum::<DVec3>() / v.len() as f64;
     v.into_iter().map(|x| x - mean).collect()
@@ -100,11 +100,11 @@ fn cosine(a: &[f64], b: &[f64]) -> f64 {
 /// joint's world position (mean removed), Hann-windowed periodograms evaluated on common bins:
 /// spacing = the coarser of the two clips' native resolutions (fps / steps), up to the lower
 /// Nyquist frequency, 0 Hz excluded. Needs 4 frames in each clip.
-pub fn frequency_alignment(source: &Clip, result: &Clip, pairs: &[(usize, usize)]) -> Result<FrequencyAlignment, MetricError> {
+pub fn frequency_alignment(source: &WorldClip, result: &WorldClip, pairs: &[(usize, usize)]) -> Result<FrequencyAlignment, MetricError> {
     check_clip(source, 4, "frequency alignment (source)")?;
     check_clip(result, 4, "frequency alignment (result)")?;
     check_pairs(source, result, pairs, "frequency alignment")?;
-    let steps = |c: &Clip| (c.frames - 1) as f64;
+    let steps = |c: &WorldClip| (c.frames - 1) as f64;
     let resolution = (source.fps / steps(source)).max(result.fps / steps(result));
     let max_hz = 0.5 * source.fps.min(result.fps);
     let bins = ((max_hz / resolution) + 1e-9).floor() as usize;
@@ -118,7 +118,7 @@ pub fn frequency_alignment(source: &Clip, result: &Clip, pairs: &[(usize, usize)
 }
 
 /// Joints in the subtree of `j` (itself included).
-fn subtree(clip: &Clip, j: usize) -> Vec<bool> {
+fn subtree(clip: &WorldClip, j: usize) -> Vec<bool> {
     let mut inside = vec![false; clip.joints];
     inside[j] = true;
     // Parents precede children in every skeleton we build; a later pass catches any that don't.
@@ -140,13 +140,18 @@ fn subtree(clip: &Clip, j: usize) -> Vec<bool> {
 /// foot below the joint is in contact" (`physics::contacts`); result frame f is compared with
 /// source frame round(f x (source frames - 1) / (result frames - 1)), so clips of different
 /// lengths compare at the same phase. `NotApplicable` when no pair reaches feet on both sides.
-pub fn contact_consistency(source: &Clip, result: &Clip, pairs: &[(usize, usize)], opts: &PhysicsOptions) -> Result<Maybe<ContactConsistency>, MetricError> {
+pub fn contact_consistency(
+    source: &WorldClip,
+    result: &WorldClip,
+    pairs: &[(usize, usize)],
+    opts: &PhysicsOptions,
+) -> Result<Maybe<ContactConsistency>, MetricError> {
     check_clip(source, 2, "contact consistency (source)")?;
     check_clip(result, 2, "contact consistency (result)")?;
     check_pairs(source, result, pairs, "contact consistency")?;
     let (src_contacts, res_contacts) = (physics::contacts(source, opts), physics::contacts(result, opts));
     // Per frame: is some foot of the subtree of j in contact? `None` when the subtree has none.
-    let signal = |clip: &Clip, rows: &[Vec<bool>], j: usize| -> Option<Vec<bool>> {
+    let signal = |clip: &WorldClip, rows: &[Vec<bool>], j: usize| -> Option<Vec<bool>> {
         clip.parents[j]?;
         let inside = subtree(clip, j);
         let feet: Vec<usize> = clip.feet.iter().enumerate().filter(|(_, &f)| inside[f]).map(|(i, _)| i).collect();
@@ -192,11 +197,11 @@ pub struct MotionRatio {
 }
 
 /// [`MotionRatio`]; `NotApplicable` when no bound source joint moves. Needs 2 frames per clip.
-pub fn motion_ratio(source: &Clip, result: &Clip, pairs: &[(usize, usize)]) -> Result<Maybe<MotionRatio>, MetricError> {
+pub fn motion_ratio(source: &WorldClip, result: &WorldClip, pairs: &[(usize, usize)]) -> Result<Maybe<MotionRatio>, MetricError> {
     check_clip(source, 2, "motion ratio (source)")?;
     check_clip(result, 2, "motion ratio (result)")?;
     check_pairs(source, result, pairs, "motion ratio")?;
-    let speed = |clip: &Clip, j: usize| -> f64 {
+    let speed = |clip: &WorldClip, j: usize| -> f64 {
         let v = velocities(clip, j);
         (v.iter().map(|x| x.length_squared()).sum::<f64>() / v.len() as f64).sqrt() / clip.scale.max(1e-12)
     };
@@ -222,7 +227,7 @@ pub fn motion_ratio(source: &Clip, result: &Clip, pairs: &[(usize, usize)]) -> R
 /// Transfer diversity: mean over pairs of samples of the mean distance between corresponding
 /// joints over all frames (clip units; normalised by the first sample's scale). Samples must
 /// share joints and frame count; fewer than 2 samples is `TooLittle`.
-pub fn diversity(samples: &[Clip]) -> Result<Measure, MetricError> {
+pub fn diversity(samples: &[WorldClip]) -> Result<Measure, MetricError> {
     if samples.len() < 2 {
         return Err(MetricError::TooLittle(format!("diversity needs at least 2 samples, got {}", samples.len())));
     }
@@ -262,7 +267,7 @@ mod tests {
     use super::*;
     use crate::metrics::physics::tests::biped;
 
-    fn sway(frames: usize, fps: f64, hz: f64, amplitude: f64) -> Clip {
+    fn sway(frames: usize, fps: f64, hz: f64, amplitude: f64) -> WorldClip {
         biped(frames, fps, move |f| DVec3::new(amplitude * (2.0 * std::f64::consts::PI * hz * f as f64 / fps).sin(), 0.0, 0.0))
     }
 
@@ -337,7 +342,7 @@ mod tests {
     }
 
     /// A foot that steps: on the ground for `down` frames, up 0.5 for `up` frames, repeating.
-    fn stepper(frames: usize, down: usize, up: usize, phase: usize) -> Clip {
+    fn stepper(frames: usize, down: usize, up: usize, phase: usize) -> WorldClip {
         biped(frames, 30.0, move |f| DVec3::new(0.0, if (f + phase) % (down + up) < down { 0.0 } else { 0.5 }, 0.0))
     }
 

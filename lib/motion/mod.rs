@@ -5,7 +5,10 @@
 //! and following Blender's importer a joint's position channels *replace* its OFFSET (missing
 //! components are zero). Joints without position channels translate by their OFFSET.
 
+pub mod clip;
 pub mod rotation;
+
+pub use clip::{Clip, ClipError};
 
 use crate::bvh::Bvh;
 use crate::skeleton::Skeleton;

@@ -16,9 +16,11 @@ pub mod labels;
 pub mod raster;
 pub mod sheet;
 
+use crate::motion::Clip;
 use crate::motion::Motion;
 use crate::skeleton::{roles, Skeleton};
 use glam::{DVec3, Vec3};
+use std::path::Path;
 
 /// One motion, ready to draw.
 #[derive(Clone, Debug)]
@@ -118,6 +120,50 @@ pub enum View {
     Top,
     /// Yaw (degrees, about +y, 0 = `Side`) and pitch (degrees, positive looks down).
     Angle { yaw: f32, pitch: f32 },
+}
+
+impl View {
+    /// A view as `mo-render --view` spells it: auto, side, front, top or YAW,PITCH in degrees.
+    pub fn parse(s: &str) -> Result<View, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "auto" => Ok(View::Auto),
+            "side" => Ok(View::Side),
+            "front" => Ok(View::Front),
+            "top" => Ok(View::Top),
+            other => {
+                let (yaw, pitch) = other.split_once(',').ok_or_else(|| format!("expected auto, side, front, top or YAW,PITCH, found '{s}'"))?;
+                let yaw: f32 = yaw.trim().parse().map_err(|_| format!("yaw '{yaw}' is not a number (degrees)"))?;
+                let pitch: f32 = pitch.trim().parse().map_err(|_| format!("pitch '{pitch}' is not a number (degrees)"))?;
+                if !yaw.is_finite() || !pitch.is_finite() || pitch.abs() > 90.0 {
+                    return Err(format!("pitch must be within -90..90 degrees, found '{s}'"));
+                }
+                Ok(View::Angle { yaw, pitch })
+            }
+        }
+    }
+}
+
+impl Track {
+    /// Tracks of clips, each cut to frames `range` (START:END, either open), titled by file name;
+    /// also the first drawn frame.
+    pub fn from_clips(loaded: &[Clip], range: Option<(Option<usize>, Option<usize>)>) -> Result<(usize, Vec<Track>), String> {
+        let start = range.and_then(|r| r.0).unwrap_or(0);
+        let mut out = Vec::with_capacity(loaded.len());
+        for l in loaded {
+            let frames = l.motion.frames;
+            if frames == 0 {
+                return Err(format!("{}: the motion has no frames (nothing to draw)", l.name));
+            }
+            let end = range.and_then(|r| r.1).unwrap_or(frames).min(frames);
+            if start >= end {
+                return Err(format!("{}: --frames starts at frame {start} but the motion has {frames} frames (0..{})", l.name, frames - 1));
+            }
+            let motion = if start == 0 && end == frames { l.motion.clone() } else { l.motion.frame_range(start, end) };
+            let title = Path::new(&l.name).file_name().map_or(l.name.clone(), |f| f.to_string_lossy().into_owned());
+            out.push(Track::from_motion(&title, &l.skeleton, &motion));
+        }
+        Ok((start, out))
+    }
 }
 
 /// A distinct, readable colour for label `i` (RGB), cycling after the table's end.

@@ -203,6 +203,18 @@ pub fn matrix_from_6d(v: [f64; 6]) -> DMat3 {
     DMat3::from_quat(rotation_from_6d(v))
 }
 
+/// What m2m loses on this clip, as a warning (None when nothing): joints whose position
+/// channels move them off their OFFSET, which m2m does not carry.
+pub fn loss_warning(motion: &Motion, skeleton: &Skeleton) -> Option<String> {
+    // Far below the 1e-4-of-size round-trip promise, far above text rounding.
+    let tolerance = 1e-5 * skeleton.rest_extent().max(f64::MIN_POSITIVE);
+    let c = max_bone_translation_change(motion, skeleton, tolerance)?;
+    Some(format!(
+        "{} joint(s) translate away from their OFFSET (up to {:.6} units: '{}' at frame {}); m2m carries only the root's translation, so decoding puts them on their OFFSETs",
+        c.joints, c.distance, skeleton.joints[c.joint].name, c.frame
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

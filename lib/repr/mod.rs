@@ -6,6 +6,7 @@
 //! motion; `anytop`: AnyTop's 13-D per-joint features).
 
 pub mod anytop;
+pub mod batch;
 pub mod m2m;
 pub mod smooth;
 /// A `[frames, joints, dims]` float32 tensor, row-major (dims fastest).
@@ -24,6 +25,17 @@ impl Features {
 
     pub fn shape(&self) -> [usize; 3] {
         [self.frames, self.joints, self.dims]
+    }
+
+    /// At least `frames` long: frames past the end are zeros (for an edit's reference, whose
+    /// values past its end are generated and never read).
+    pub fn padded_to(&self, frames: usize) -> Features {
+        let mut padded = self.clone();
+        if padded.frames < frames {
+            padded.data.resize(frames * padded.joints * padded.dims, 0.0);
+            padded.frames = frames;
+        }
+        padded
     }
 
     /// The feature vector of one joint at one frame.

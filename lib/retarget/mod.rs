@@ -23,6 +23,7 @@
 //!
 //! Frame rates are the caller's business: `resample` brings the source to the examples' rate.
 
+mod describe;
 mod features;
 pub mod settings;
 #[cfg(test)]

@@ -51,23 +51,23 @@ pub fn parse_info(json: &[u8]) -> Result<SataInfo, CheckpointError> {
 }
 
 /// A checkpoint with trainable variables (for resuming).
-pub struct Loaded {
+pub struct LoadedAutoencoder {
     pub info: SataInfo,
     pub varmap: VarMap,
     pub model: SataModel,
 }
 
-pub fn load(dir: &Path, device: &Device) -> Result<Loaded, CheckpointError> {
+pub fn load(dir: &Path, device: &Device) -> Result<LoadedAutoencoder, CheckpointError> {
     let (json, weights) = read_dir_files(dir)?;
     let info = parse_info(&json).map_err(CheckpointError::of(format!("model {}", dir.display())))?;
     let varmap = VarMap::new();
     let model = SataModel::new(seeded_var_builder(&varmap, 0, device), &info.config)?;
     fill_vars(&varmap, &weights, device).map_err(CheckpointError::of(format!("model {}", dir.display())))?;
-    Ok(Loaded { info, varmap, model })
+    Ok(LoadedAutoencoder { info, varmap, model })
 }
 
 /// A model for inference only: plain tensors, so no op is recorded for a backward pass.
-pub struct Frozen {
+pub struct FrozenAutoencoder {
     pub info: SataInfo,
     pub model: SataModel,
     /// The rigs of the skeletons it was trained on (empty for models from before `rigs.json`).
@@ -75,17 +75,17 @@ pub struct Frozen {
 }
 
 /// `rigs`: the contents of `rigs.json`, if the model has one.
-pub fn frozen_bytes(json: &[u8], weights: &[u8], rigs: Option<&[u8]>, device: &Device) -> Result<Frozen, CheckpointError> {
+pub fn frozen_bytes(json: &[u8], weights: &[u8], rigs: Option<&[u8]>, device: &Device) -> Result<FrozenAutoencoder, CheckpointError> {
     let info = parse_info(json)?;
     let tensors =
         candle_core::safetensors::load_buffer(weights, device).map_err(CheckpointError::tensor("model.safetensors: not a safetensors file".into()))?;
     let vb = candle_nn::VarBuilder::from_tensors(tensors, candle_core::DType::F32, device);
     let model = SataModel::new(vb, &info.config).map_err(CheckpointError::Mismatch)?;
     let rigs = rigs.map(KnownRigs::parse).transpose()?.unwrap_or_default();
-    Ok(Frozen { info, model, rigs })
+    Ok(FrozenAutoencoder { info, model, rigs })
 }
 
-pub fn frozen(dir: &Path, device: &Device) -> Result<Frozen, CheckpointError> {
+pub fn frozen(dir: &Path, device: &Device) -> Result<FrozenAutoencoder, CheckpointError> {
     let (json, weights) = read_dir_files(dir)?;
     let mut model = frozen_bytes(&json, &weights, None, device).map_err(CheckpointError::of(format!("model {}", dir.display())))?;
     model.rigs = KnownRigs::read(dir)?;
@@ -93,7 +93,7 @@ pub fn frozen(dir: &Path, device: &Device) -> Result<Frozen, CheckpointError> {
 }
 
 /// The latent model that ships inside the binaries (models/zoo-sata, see its MODEL_CARD.md).
-pub fn frozen_default(device: &Device) -> Result<Frozen, CheckpointError> {
+pub fn frozen_default(device: &Device) -> Result<FrozenAutoencoder, CheckpointError> {
     const INFO: &[u8] = include_bytes!("../../models/zoo-sata/checkpoint.json");
     const WEIGHTS: &[u8] = include_bytes!("../../models/zoo-sata/model.safetensors");
     const RIGS: &[u8] = include_bytes!("../../models/zoo-sata/rigs.json");

@@ -2,7 +2,7 @@
 //! windows overlapping by 16, the overlapping frames cropped from the latter window), the
 //! latent mean as the code (no sampling at inference), raw AnyTop features in and out.
 
-use super::checkpoint::Frozen;
+use super::checkpoint::FrozenAutoencoder;
 use super::graph::SkeletonGraph;
 use super::{SataError, FEATURE_DIMS};
 use crate::document::AnyTopSection;
@@ -55,19 +55,19 @@ pub struct Latents {
 }
 
 /// A skeleton ready for the model: its AnyTop record (rig) and graph tensors.
-pub struct Prepared {
+pub struct PreparedSkeleton {
     pub section: AnyTopSection,
     pub graph: SkeletonGraph,
 }
 
-impl Prepared {
-    pub fn new(skeleton: &Skeleton, section: AnyTopSection, names: &NameTable, device: &Device) -> Result<Prepared, SataError> {
+impl PreparedSkeleton {
+    pub fn new(skeleton: &Skeleton, section: AnyTopSection, names: &NameTable, device: &Device) -> Result<PreparedSkeleton, SataError> {
         let graph = SkeletonGraph::new(skeleton, &section.rig, &names.embed_skeleton(skeleton), device)?;
-        Ok(Prepared { section, graph })
+        Ok(PreparedSkeleton { section, graph })
     }
 }
 
-impl Frozen {
+impl FrozenAutoencoder {
     /// Latent means of raw AnyTop features `[frames, J, 13]` of the skeleton `g`.
     pub fn encode_features(&self, features: &Features, g: &SkeletonGraph, device: &Device) -> Result<Latents, SataError> {
         if features.dims != FEATURE_DIMS || features.joints != g.joints {
@@ -139,7 +139,14 @@ impl Frozen {
 
     /// A motion of `target` that the latents describe, placed where the target's rest pose
     /// stands, with `frame_time`.
-    pub fn decode_motion(&self, latents: &Latents, target: &Skeleton, prepared: &Prepared, frame_time: f64, device: &Device) -> Result<Motion, SataError> {
+    pub fn decode_motion(
+        &self,
+        latents: &Latents,
+        target: &Skeleton,
+        prepared: &PreparedSkeleton,
+        frame_time: f64,
+        device: &Device,
+    ) -> Result<Motion, SataError> {
         let features = self.decode_latents(latents, &prepared.graph, device)?;
         let rig = &prepared.section.rig;
         let mut motion = rig.decode(target, &features, &rig.rest_placement())?;

@@ -26,6 +26,7 @@
 //! training set and kept in the checkpoint ([`train::FeatureScale`]).
 
 pub mod checkpoint;
+pub mod clips;
 pub mod graph;
 pub mod infer;
 pub mod model;

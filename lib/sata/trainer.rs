@@ -34,7 +34,7 @@ pub struct SataOptions {
 
 /// A SATA checkpoint to continue, with its optimiser state.
 pub struct SataResume {
-    loaded: checkpoint::Loaded,
+    loaded: checkpoint::LoadedAutoencoder,
     opt: AdamW,
 }
 

@@ -27,6 +27,7 @@
 //!
 //! Everything is sequential f64 arithmetic in a fixed order: same input and seed, same labels.
 
+pub mod input;
 mod kmeans;
 mod pca;
 

@@ -9,14 +9,14 @@
 
 use super::arthropod::{centipede_body, crab_body, place_jointed_leg, spider_body, CentipedeBody, CrabBody, SpiderBody};
 use super::route::FootSpec;
-use super::training::{Action, Clip, Job, Plan};
+use super::training::{Action, Job, Plan, TrainingClip};
 use super::*;
 
 fn scaled(gait: Gait, r: f64) -> Gait {
     Gait { period: gait.period * r.sqrt(), stride: gait.stride * r, lift: gait.lift * r, ..gait }
 }
 
-pub(super) fn spider(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn spider(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     let SpiderBody { skel, body_y, abdomen, fangs, legs } = spider_body(&job.shape);
     let r = job.shape.size * job.shape.limbs;
     let fast = job.action == Action::Run;
@@ -62,10 +62,10 @@ pub(super) fn spider(job: &Job, rng: &mut SplitMix64) -> Clip {
         }
     });
     let boundaries = plan.boundaries(&feet.iter().collect::<Vec<_>>());
-    Clip { skeleton: skel, motion, boundaries }
+    TrainingClip { skeleton: skel, motion, boundaries }
 }
 
-pub(super) fn crab(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn crab(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     let CrabBody { skel, body_y, eyes, claws, legs } = crab_body(&job.shape);
     let r = job.shape.size * job.shape.limbs;
     let fast = job.action == Action::Run;
@@ -115,10 +115,10 @@ pub(super) fn crab(job: &Job, rng: &mut SplitMix64) -> Clip {
         }
     });
     let boundaries = plan.boundaries(&feet.iter().collect::<Vec<_>>());
-    Clip { skeleton: skel, motion, boundaries }
+    TrainingClip { skeleton: skel, motion, boundaries }
 }
 
-pub(super) fn centipede(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn centipede(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     let CentipedeBody { skel, body_y, seg_len, head, antennae, segments, tail, legs, claw } = centipede_body(&job.shape);
     let r = job.shape.size * job.shape.limbs;
     let fast = job.action == Action::Run;
@@ -170,5 +170,5 @@ pub(super) fn centipede(job: &Job, rng: &mut SplitMix64) -> Clip {
         }
     });
     let boundaries = plan.boundaries(&feet.iter().collect::<Vec<_>>());
-    Clip { skeleton: skel, motion, boundaries }
+    TrainingClip { skeleton: skel, motion, boundaries }
 }

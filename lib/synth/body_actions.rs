@@ -10,11 +10,11 @@
 
 use super::bird::{bird_body, BirdBody};
 use super::route::FootSpec;
-use super::training::{Action, Clip, Job, Plan};
+use super::training::{Action, Job, Plan, TrainingClip};
 use super::undulating::{fish_body, snake_body, FishBody, SnakeBody};
 use super::*;
 
-pub(super) fn bird(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn bird(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     let shape = job.shape;
     let body = bird_body(&shape);
     let BirdBody { skel, spine, chest, neck1, neck2, head, wings, legs, tail: [tail1, tail2], hip_drop, shin, tarsus, ankle_y } = body;
@@ -112,7 +112,7 @@ pub(super) fn bird(job: &Job, rng: &mut SplitMix64) -> Clip {
         }
     });
     let boundaries = plan.boundaries(&feet.iter().collect::<Vec<_>>());
-    Clip { skeleton: skel, motion, boundaries }
+    TrainingClip { skeleton: skel, motion, boundaries }
 }
 
 /// A curve sampled by its own arc length.
@@ -131,7 +131,7 @@ impl Curve {
     }
 }
 
-pub(super) fn snake(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn snake(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     let shape = job.shape;
     let SnakeBody { skel, radius, jaw, neck, body } = snake_body(&shape);
     let k = shape.size;
@@ -190,10 +190,10 @@ pub(super) fn snake(job: &Job, rng: &mut SplitMix64) -> Clip {
             p.world(j, aim(DVec3::NEG_Z, DVec3::Y, at(next) - at(arc[j]), DVec3::Y));
         }
     });
-    Clip { skeleton: skel, motion, boundaries: Vec::new() }
+    TrainingClip { skeleton: skel, motion, boundaries: Vec::new() }
 }
 
-pub(super) fn fish(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn fish(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     let shape = job.shape;
     let depth = 0.5 * shape.size.max(1.0);
     let FishBody { skel, head, jaw, fins, pelvic, dorsal, spine, length } = fish_body(&shape, depth);
@@ -260,5 +260,5 @@ pub(super) fn fish(job: &Job, rng: &mut SplitMix64) -> Clip {
         }
         p.local(dorsal, rz(5.0 * wave(c - 0.4)));
     });
-    Clip { skeleton: skel, motion, boundaries: Vec::new() }
+    TrainingClip { skeleton: skel, motion, boundaries: Vec::new() }
 }

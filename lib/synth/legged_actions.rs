@@ -8,7 +8,7 @@
 
 use super::legged::{biped_body, quad_training_body, BipedBody, QuadBody};
 use super::route::FootSpec;
-use super::training::{Action, Clip, Job, Plan};
+use super::training::{Action, Job, Plan, TrainingClip};
 use super::*;
 
 /// Stride and lift scale with `r` (leg length over the example's), the period with its root.
@@ -53,7 +53,7 @@ impl Idle {
     }
 }
 
-pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     let shape = job.shape;
     let BipedBody { skel, spine, neck, head, arms, arm_rest, legs } = biped_body(&shape, &job.rig);
     let (k, r) = (shape.size, shape.size * shape.limbs);
@@ -143,21 +143,21 @@ pub(super) fn biped(job: &Job, rng: &mut SplitMix64) -> Clip {
         }
     });
     let boundaries = plan.boundaries(&feet.iter().collect::<Vec<_>>());
-    Clip { skeleton: skel, motion, boundaries }
+    TrainingClip { skeleton: skel, motion, boundaries }
 }
 
-pub(super) fn quadruped(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn quadruped(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     four_legged(job, false, rng)
 }
 
-pub(super) fn dragon(job: &Job, rng: &mut SplitMix64) -> Clip {
+pub(super) fn dragon(job: &Job, rng: &mut SplitMix64) -> TrainingClip {
     four_legged(job, true, rng)
 }
 
 /// Walk: lateral sequence (LH, LF, RH, RF a quarter apart). Run: a trot (diagonal pairs), with
 /// a shorter stance and longer stride. Idle: standing, looking around, tail swishing, wings
 /// (dragon) half folded and stirring.
-fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
+fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> TrainingClip {
     let shape = job.shape;
     let body = quad_training_body(dragon, &shape, &job.rig);
     let QuadBody { skel, spine, neck, head, jaw, ears, tail, wings, legs, hip_drop, bone, ankle_y } = body;
@@ -258,5 +258,5 @@ fn four_legged(job: &Job, dragon: bool, rng: &mut SplitMix64) -> Clip {
         }
     });
     let boundaries = plan.boundaries(&feet.iter().collect::<Vec<_>>());
-    Clip { skeleton: skel, motion, boundaries }
+    TrainingClip { skeleton: skel, motion, boundaries }
 }

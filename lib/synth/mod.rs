@@ -35,7 +35,7 @@ mod undulating;
 
 pub(crate) use rig::human_name;
 pub use rig::{rig, Naming, Rig, UpAxis, RIG_VARIANTS};
-pub use training::{actions, proportions, training_clip, write_training_zoo, Action, Clip, Proportions, CLIP_FRAMES};
+pub use training::{actions, proportions, training_clip, write_training_zoo, Action, Proportions, TrainingClip, CLIP_FRAMES};
 
 #[cfg(test)]
 mod rig_tests;

@@ -12,7 +12,7 @@
 //! training zoo the built-in model was trained on (variants 0-7) stay byte-identical; every
 //! variant from `RIG_VARIANTS` on draws its conventions from its number alone.
 
-use super::training::Clip;
+use super::training::TrainingClip;
 use super::*;
 
 /// First training-zoo variant whose conventions are drawn instead of native.
@@ -190,7 +190,7 @@ pub(crate) fn human_name(naming: Naming, part: HumanPart, left: Option<bool>) ->
 /// Re-express a clip in `rig`'s axis, unit and root conventions (naming and anatomy are the
 /// body builders' business). World positions change by exactly the axis rotation and the unit
 /// scale, so the motion is the same motion.
-pub(crate) fn apply(rig: &Rig, clip: &mut Clip) {
+pub(crate) fn apply(rig: &Rig, clip: &mut TrainingClip) {
     let scale = if rig.centimetres { 100.0 } else { 1.0 };
     let turn = match rig.up {
         UpAxis::Y => DQuat::IDENTITY,
@@ -238,7 +238,7 @@ pub(crate) fn apply(rig: &Rig, clip: &mut Clip) {
 /// 3ds Max Biped files put the body's centre node `Bip01` above `Bip01_Pelvis`: `Bip01` carries
 /// the position and orientation, the pelvis hangs from it with a zero offset and rotation
 /// channels only. A re-expression: every joint stays where it was.
-pub(crate) fn add_biped_centre(clip: &mut Clip) {
+pub(crate) fn add_biped_centre(clip: &mut TrainingClip) {
     let skel = &mut clip.skeleton;
     let mut centre = skel.joints[0].clone();
     centre.name = "Bip01".into();

@@ -18,11 +18,11 @@ fn main_action(name: &str) -> Action {
     }
 }
 
-fn clip(name: &str, variant: u64) -> Clip {
+fn clip(name: &str, variant: u64) -> TrainingClip {
     training_clip(name, variant, main_action(name), 4, FRAMES).unwrap()
 }
 
-fn joint_names(c: &Clip) -> BTreeSet<String> {
+fn joint_names(c: &TrainingClip) -> BTreeSet<String> {
     c.skeleton.joints.iter().map(|j| j.name.clone()).collect()
 }
 
@@ -160,7 +160,7 @@ fn z_up_centimetre_and_origin_rigs_exist_and_look_like_it() {
     let (lo, hi) = clip("biped", v).skeleton.rest_bounds();
     assert!((hi - lo).y > 2.0 * (hi - lo).z, "biped v{v} Y-up: rest size {}", hi - lo);
     // Centimetres: a human is 150-250 units tall, against 1.5-2.5 in metres.
-    let tall = |c: &Clip| {
+    let tall = |c: &TrainingClip| {
         let (lo, hi) = c.skeleton.rest_bounds();
         (hi - lo).max_element()
     };

@@ -29,7 +29,7 @@ pub enum Action {
     Idle,
     /// Walking (or swimming, slithering) along a curve; the heading turns 60-120 degrees.
     Turn,
-    /// Walk, come to a stop, stand about a second, walk again. `Clip::boundaries` gives the
+    /// Walk, come to a stop, stand about a second, walk again. `TrainingClip::boundaries` gives the
     /// frames where standing begins and ends.
     WalkStopWalk,
     /// Slow lateral undulation (snake) or cruising (fish).
@@ -128,7 +128,7 @@ pub fn proportions(name: &str, variant: u64) -> Option<Proportions> {
 
 /// One training clip.
 #[derive(Clone, Debug)]
-pub struct Clip {
+pub struct TrainingClip {
     pub skeleton: Skeleton,
     pub motion: Motion,
     /// Frames where the action changes (walk -> stand -> walk); empty for single actions.
@@ -141,7 +141,7 @@ pub const CLIP_FRAMES: std::ops::RangeInclusive<usize> = 30..=3000;
 /// `frames` frames of creature `name`, body `variant`, doing `action`, jittered by `seed`.
 /// `None` for an unknown creature or an action it does not perform (see `actions`). Frame
 /// counts outside `CLIP_FRAMES` are clamped into it.
-pub fn training_clip(name: &str, variant: u64, action: Action, seed: u64, frames: usize) -> Option<Clip> {
+pub fn training_clip(name: &str, variant: u64, action: Action, seed: u64, frames: usize) -> Option<TrainingClip> {
     let (mut clip, rig) = native_clip(name, variant, action, seed, frames)?;
     rig::apply(&rig, &mut clip);
     Some(clip)
@@ -149,7 +149,7 @@ pub fn training_clip(name: &str, variant: u64, action: Action, seed: u64, frames
 
 /// `training_clip` before its axes, units and root are converted to the variant's rig (names
 /// and anatomy are already the rig's): Y-up metres, root OFFSET at the hips.
-pub(crate) fn native_clip(name: &str, variant: u64, action: Action, seed: u64, frames: usize) -> Option<(Clip, Rig)> {
+pub(crate) fn native_clip(name: &str, variant: u64, action: Action, seed: u64, frames: usize) -> Option<(TrainingClip, Rig)> {
     if !actions(name).contains(&action) {
         return None;
     }

@@ -10,12 +10,12 @@ use crate::skeleton::roles;
 /// Short clips keep the whole table fast in debug builds; long enough for several steps.
 const FRAMES: usize = 150;
 
-fn clip(name: &str, variant: u64, action: Action) -> Clip {
+fn clip(name: &str, variant: u64, action: Action) -> TrainingClip {
     training_clip(name, variant, action, 11, FRAMES).unwrap_or_else(|| panic!("{name} {action:?}"))
 }
 
 /// Root positions on the ground plane, per frame.
-fn root_track(c: &Clip) -> Vec<DVec3> {
+fn root_track(c: &TrainingClip) -> Vec<DVec3> {
     let world = c.motion.forward_kinematics(&c.skeleton);
     (0..c.motion.frames).map(|f| world.position(f, 0) * DVec3::new(1.0, 0.0, 1.0)).collect()
 }
@@ -27,7 +27,7 @@ fn mean_speed(track: &[DVec3], a: usize, b: usize) -> f64 {
 }
 
 /// Lowest height any joint or End Site reaches in the clip.
-fn lowest_point(c: &Clip) -> f64 {
+fn lowest_point(c: &TrainingClip) -> f64 {
     let world = c.motion.forward_kinematics(&c.skeleton);
     let mut lowest = f64::INFINITY;
     for f in 0..c.motion.frames {

@@ -5,7 +5,7 @@ use crate::common;
 
 use menagerie::bvh;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig, AnyTopStats, Facing, IkOptions, Placement, RestSource, DIM_CONTACT, FEATURE_DIMS};
+use menagerie::repr::anytop::{AnyTopRig, AnyTopStats, Facing, IkOptions, Placement, RestSource, RigOptions, DIM_CONTACT, FEATURE_DIMS};
 use menagerie::repr::Features;
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;
@@ -144,7 +144,7 @@ fn check_file(path: &Path) -> Report {
     let mut report = Report::default();
     let clip = load(path, usize::MAX);
     let (rest, source) = rest_for(path, &clip);
-    let rig = AnyTopRig::new(&clip.skeleton, &rest.motion, &AnyTopOptions { rest_source: source, ..Default::default() })
+    let rig = AnyTopRig::new(&clip.skeleton, &rest.motion, &RigOptions { rest_source: source, ..Default::default() })
         .unwrap_or_else(|e| panic!("{}: {e}", clip.name));
     let skeleton = &clip.skeleton;
     report.files = 1;
@@ -266,7 +266,7 @@ fn check_travels_forward(name: &str, f: &Features, assert_it: bool) {
 
 fn check_invariants(path: &Path) -> (String, usize, usize) {
     let clip = load(path, usize::MAX);
-    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &AnyTopOptions::default()).unwrap();
+    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &RigOptions::default()).unwrap();
     let f = rig.encode(&clip.skeleton, &clip.motion).unwrap().features;
     let mut contacts = 0;
     for t in 0..f.frames {
@@ -318,7 +318,7 @@ fn invariants_hold_on_example_creatures() {
 fn rig_json_round_trip_decodes_identically() {
     let path = common::example_bvh_files().into_iter().find(|p| p.ends_with("quadruped.bvh")).unwrap();
     let clip = load(&path, 60);
-    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &AnyTopOptions::default()).unwrap();
+    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &RigOptions::default()).unwrap();
     let json = serde_json::to_string_pretty(&rig).unwrap();
     let back: AnyTopRig = serde_json::from_str(&json).unwrap();
     assert_eq!(back, rig);
@@ -340,7 +340,7 @@ fn rig_json_round_trip_decodes_identically() {
 fn a_damaged_rig_or_mismatched_input_is_an_error() {
     let path = common::example_bvh_files().into_iter().find(|p| p.ends_with("biped.bvh")).unwrap();
     let clip = load(&path, 10);
-    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &AnyTopOptions::default()).unwrap();
+    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &RigOptions::default()).unwrap();
     let enc = rig.encode(&clip.skeleton, &clip.motion).unwrap();
     let mut bad = rig.clone();
     bad.facing = Facing::FaceJoints([0, 1, 2, 999]);
@@ -361,7 +361,7 @@ fn a_damaged_rig_or_mismatched_input_is_an_error() {
         j.offset *= 2.0;
     }
     assert!(rig.decode(&bigger, &enc.features, &enc.placement).is_err());
-    let options = AnyTopOptions { feet: Some(vec![clip.skeleton.len()]), ..Default::default() };
+    let options = RigOptions { feet: Some(vec![clip.skeleton.len()]), ..Default::default() };
     assert!(AnyTopRig::new(&clip.skeleton, &clip.motion, &options).is_err());
 }
 
@@ -370,7 +370,7 @@ fn a_damaged_rig_or_mismatched_input_is_an_error() {
 fn rest_row_is_the_processed_rest_frame() {
     for path in common::example_bvh_files() {
         let clip = load(&path, 5);
-        let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &AnyTopOptions::default()).unwrap();
+        let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &RigOptions::default()).unwrap();
         let row = rig.rest_features(&clip.skeleton, &clip.motion).unwrap();
         assert_eq!(row.shape(), [1, clip.skeleton.len(), FEATURE_DIMS]);
         let first = rig.encode(&clip.skeleton, &clip.motion).unwrap().features;
@@ -450,7 +450,7 @@ fn statistics_group_as_the_reference() {
 fn generated_like_features_decode_to_finite_motion() {
     let path = common::example_bvh_files().into_iter().find(|p| p.ends_with("spider.bvh")).unwrap();
     let clip = load(&path, 40);
-    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &AnyTopOptions::default()).unwrap();
+    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &RigOptions::default()).unwrap();
     let mut f = rig.encode(&clip.skeleton, &clip.motion).unwrap().features;
     let mut state = 12345u64;
     for v in f.data.iter_mut() {
@@ -470,7 +470,7 @@ fn generated_like_features_decode_to_finite_motion() {
 fn ik_follows_noisy_positions() {
     let path = common::example_bvh_files().into_iter().find(|p| p.ends_with("quadruped.bvh")).unwrap();
     let clip = load(&path, 40);
-    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &AnyTopOptions::default()).unwrap();
+    let rig = AnyTopRig::new(&clip.skeleton, &clip.motion, &RigOptions::default()).unwrap();
     let enc = rig.encode(&clip.skeleton, &clip.motion).unwrap();
     let mut f = enc.features.clone();
     let amplitude = 0.01f32; // scaled units, i.e. 5% of the mean bone

@@ -7,14 +7,14 @@ use crate::common;
 use menagerie::binding::auto::{auto_bind, AutoOptions, Body, Choice};
 use menagerie::correspond::Evidence;
 use menagerie::document::AnyTopSection;
-use menagerie::repr::anytop::AnyTopOptions;
+use menagerie::repr::anytop::RigOptions;
 use menagerie::skeleton::Skeleton;
 use std::path::Path;
 
 /// The AnyTop rig's natural rest pose: both creatures face +z.
 fn rest(path: &Path) -> (Skeleton, Vec<glam::DVec3>) {
     let (skeleton, motion) = common::load(path);
-    let section = AnyTopSection::new(&skeleton, &motion.first_frames(2), &AnyTopOptions::default()).unwrap();
+    let section = AnyTopSection::new(&skeleton, &motion.first_frames(2), &RigOptions::default()).unwrap();
     let rest = section.rig.rest_positions(&skeleton);
     (skeleton, rest)
 }
@@ -102,7 +102,7 @@ fn skel_aug_variants_bind_back_to_their_original() {
             let options = Options { remove: Some(RemoveAmount::Random), add: 2, keep_feet: true };
             let plan = augment::plan(&skeleton, &options, &mut SplitMix64::new(seed));
             let variant = plan.apply_motion(&skeleton, &motion);
-            let section = AnyTopSection::new(&plan.skeleton, &variant.first_frames(2), &AnyTopOptions::default()).unwrap();
+            let section = AnyTopSection::new(&plan.skeleton, &variant.first_frames(2), &RigOptions::default()).unwrap();
             let rb = section.rig.rest_positions(&plan.skeleton);
             for (names, total) in [(true, &mut with_names), (false, &mut geometry)] {
                 let evidence = if names { Evidence::ALL } else { Evidence::GEOMETRY };

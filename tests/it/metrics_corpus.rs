@@ -7,33 +7,33 @@ use menagerie::bvh;
 use menagerie::metrics::geometric::{self, GeometricOptions};
 use menagerie::metrics::physics::{self, Maybe, PhysicsOptions};
 use menagerie::metrics::reconstruction::{self, Rotations};
-use menagerie::metrics::{kinetic, transfer, Clip, MetricError};
+use menagerie::metrics::{kinetic, transfer, MetricError, WorldClip};
 use menagerie::motion::Motion;
 use menagerie::skeleton::Skeleton;
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
 
-fn load(path: &Path) -> (Skeleton, Motion, Clip) {
+fn load(path: &Path) -> (Skeleton, Motion, WorldClip) {
     let parsed = bvh::read_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let skeleton = Skeleton::from_bvh(&parsed);
     let motion = Motion::from_bvh(&parsed, &skeleton);
-    let clip = Clip::from_motion(&skeleton, &motion);
+    let clip = WorldClip::from_motion(&skeleton, &motion);
     (skeleton, motion, clip)
 }
 
-fn example(name: &str) -> (Skeleton, Motion, Clip) {
+fn example(name: &str) -> (Skeleton, Motion, WorldClip) {
     load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data").join(name))
 }
 
 /// Frames `start..start + len` of a clip.
-fn window(clip: &Clip, start: usize, len: usize) -> Clip {
+fn window(clip: &WorldClip, start: usize, len: usize) -> WorldClip {
     let j = clip.joints;
-    Clip { frames: len, positions: clip.positions[start * j..(start + len) * j].to_vec(), ..clip.clone() }
+    WorldClip { frames: len, positions: clip.positions[start * j..(start + len) * j].to_vec(), ..clip.clone() }
 }
 
-fn map_positions(clip: &Clip, f: impl Fn(DVec3) -> DVec3) -> Clip {
-    Clip { positions: clip.positions.iter().map(|&p| f(p)).collect(), ..clip.clone() }
+fn map_positions(clip: &WorldClip, f: impl Fn(DVec3) -> DVec3) -> WorldClip {
+    WorldClip { positions: clip.positions.iter().map(|&p| f(p)).collect(), ..clip.clone() }
 }
 
 #[test]
@@ -80,7 +80,7 @@ fn a_motion_against_itself_identical_shifted_mirrored_scaled() {
     // Scaled by s about the origin: joints move (s - 1)|p|; kinetic energies scale by s²,
     // energy expenditure by s; normalised physics (with the scale scaled too) is unchanged.
     let s = 2.5;
-    let scaled = Clip { scale: clip.scale * s, ..map_positions(&clip, |p| p * s) };
+    let scaled = WorldClip { scale: clip.scale * s, ..map_positions(&clip, |p| p * s) };
     let by_hand = clip.positions.iter().map(|p| (s - 1.0) * p.length()).sum::<f64>() / clip.positions.len() as f64;
     let r = reconstruction::reconstruction(&clip, &scaled, None, height, &opts).unwrap();
     assert!((r.jp.value - by_hand).abs() < 1e-12);
@@ -103,7 +103,7 @@ fn a_motion_against_itself_identical_shifted_mirrored_scaled() {
 #[test]
 fn a_constant_pose_has_no_jitter_energy_or_diversity() {
     let (_, _, clip) = example("quadruped.bvh");
-    let frozen = Clip { positions: (0..clip.frames).flat_map(|_| clip.frame(0).to_vec()).collect(), ..clip.clone() };
+    let frozen = WorldClip { positions: (0..clip.frames).flat_map(|_| clip.frame(0).to_vec()).collect(), ..clip.clone() };
     let p = physics::physics(&frozen, &PhysicsOptions::default()).unwrap();
     assert_eq!(p.jitter.value().unwrap().value, 0.0);
     assert_eq!(p.foot_skating.value().unwrap().value, 0.0);
@@ -224,7 +224,7 @@ fn physics_on_every_corpus_file() {
     let Some(data) = common::shared_data("physics_on_every_corpus_file") else { return };
     let files = common::corpus_bvh_files(&data);
     let t0 = Instant::now();
-    let clips: Vec<(String, Clip)> = files.par_iter().map(|p| (p.strip_prefix(&data).unwrap_or(p).display().to_string(), load(p).2)).collect();
+    let clips: Vec<(String, WorldClip)> = files.par_iter().map(|p| (p.strip_prefix(&data).unwrap_or(p).display().to_string(), load(p).2)).collect();
     let loading = t0.elapsed();
     let frames: usize = clips.iter().map(|(_, c)| c.frames).sum();
     let t1 = Instant::now();

@@ -8,9 +8,9 @@ use menagerie::bvh;
 use menagerie::cli::mo_sample::DEFAULT_SMOOTH_HZ;
 use menagerie::diffusion::sample::PostProcess;
 use menagerie::metrics::movement::energy;
-use menagerie::metrics::Clip;
+use menagerie::metrics::WorldClip;
 use menagerie::motion::Motion;
-use menagerie::repr::anytop::{AnyTopOptions, AnyTopRig, IkOptions};
+use menagerie::repr::anytop::{AnyTopRig, IkOptions, RigOptions};
 use menagerie::repr::smooth::lambda_for_cutoff;
 use menagerie::skeleton::Skeleton;
 use std::path::Path;
@@ -21,7 +21,7 @@ fn ratio(path: &Path) -> f64 {
     let b = bvh::read_path(path).unwrap_or_else(|e| panic!("{e}"));
     let skeleton = Skeleton::from_bvh(&b);
     let motion = Motion::from_bvh_frames(&b, &skeleton, 0..b.frames);
-    let rig = AnyTopRig::new(&skeleton, &motion, &AnyTopOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let rig = AnyTopRig::new(&skeleton, &motion, &RigOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let enc = rig.encode(&skeleton, &motion).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let fps = 1.0 / motion.frame_time;
     let post = PostProcess { smooth: lambda_for_cutoff(DEFAULT_SMOOTH_HZ, fps), blend: 0, plant_feet: true };
@@ -29,7 +29,7 @@ fn ratio(path: &Path) -> f64 {
     post.apply(&mut processed, &rig.feet, None);
     let decode = |f| {
         let m = rig.decode_ik(&skeleton, f, &enc.placement, &IkOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        energy(&Clip::from_motion(&skeleton, &m), 5)
+        energy(&WorldClip::from_motion(&skeleton, &m), 5)
     };
     decode(&processed) / decode(&enc.features)
 }

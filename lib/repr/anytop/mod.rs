@@ -115,11 +115,14 @@
 mod decode;
 mod encode;
 mod ik;
+pub mod named;
+pub mod placements;
 mod plant;
 mod rig;
 mod stats;
 
 pub use ik::IkOptions;
+pub use named::NamedOverrides;
 pub use plant::plant_feet;
 pub use rig::AnyTopRig;
 pub use stats::AnyTopStats;
@@ -149,12 +152,8 @@ pub const DIMS_ROTATION: std::ops::Range<usize> = 3..9;
 pub const DIMS_VELOCITY: std::ops::Range<usize> = 9..12;
 pub const DIM_CONTACT: usize = 12;
 
-/// AnyTop's T-pose rule: a clip whose file name (not its directories) contains "tpos", in
-/// any case, holds the rest pose.
-pub fn names_tpose(path: &str) -> bool {
-    let file = path.rsplit(['/', '\\']).next().unwrap_or(path);
-    file.to_lowercase().contains("tpos")
-}
+/// AnyTop's T-pose rule lives with the clip files it looks at.
+pub use crate::motion::clip::names_tpose;
 
 /// How a clip's facing direction is measured from joint positions.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -233,7 +232,7 @@ pub enum Provenance {
 
 /// Choices for building a rig.
 #[derive(Clone, Debug, PartialEq)]
-pub struct AnyTopOptions {
+pub struct RigOptions {
     /// `[r_hip, l_hip, r_shoulder, l_shoulder]` instead of the automatic choice.
     pub face_joints: Option<[usize; 4]>,
     /// `[front, back]` for a body-axis facing instead of the automatic choice (ignored when
@@ -245,9 +244,9 @@ pub struct AnyTopOptions {
     pub rest_source: RestSource,
 }
 
-impl Default for AnyTopOptions {
+impl Default for RigOptions {
     fn default() -> Self {
-        AnyTopOptions { face_joints: None, body_axis: None, feet: None, rest_source: RestSource::Unrecorded }
+        RigOptions { face_joints: None, body_axis: None, feet: None, rest_source: RestSource::Unrecorded }
     }
 }
 

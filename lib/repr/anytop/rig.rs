@@ -18,7 +18,7 @@
 //! faces along its body: front and back are the ends of the skeleton's longest path (by bone
 //! length), front being the end nearer the head (else away from the tail, else nearer the root).
 
-use super::{heading_of, yaw_to_front, AnyTopError, AnyTopOptions, Facing, Provenance, RestSource, HUMANML_MEAN_BONE_LENGTH};
+use super::{heading_of, yaw_to_front, AnyTopError, Facing, Provenance, RestSource, RigOptions, HUMANML_MEAN_BONE_LENGTH};
 use crate::motion::Motion;
 use crate::repr::Features;
 use crate::skeleton::names::{self, Side};
@@ -136,7 +136,7 @@ impl Prepared {
 impl AnyTopRig {
     /// Process a skeleton's rest clip: `rest`'s frame 0 is the rest pose; all its frames
     /// count for the ground height.
-    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &AnyTopOptions) -> Result<AnyTopRig, AnyTopError> {
+    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &RigOptions) -> Result<AnyTopRig, AnyTopError> {
         skeleton.validate()?;
         let n = skeleton.len();
         if rest.joints != n {
@@ -554,6 +554,26 @@ fn body_axis(skeleton: &Skeleton, parents: &[Option<usize>], children: &[Vec<usi
         }
     };
     Facing::BodyAxis { front, back }
+}
+
+impl AnyTopRig {
+    /// One line about the rig (`mo-encode -v`): where its rest pose came from, its facing, feet and scale.
+    pub fn describe(&self, skeleton: &Skeleton) -> String {
+        let rig = self;
+        let name = |j: usize| skeleton.joints.get(j).map_or("?", |x| x.name.as_str());
+        let how = |p: Provenance| if p == Provenance::Override { "given" } else { "automatic" };
+        let rest = match &rig.rest_source {
+            RestSource::TPose { file } => format!("rest pose frame 0 of {file} (T-pose)"),
+            RestSource::FirstClip { file } | RestSource::Explicit { file } => format!("rest pose frame 0 of {file}"),
+            RestSource::Offsets => "rest pose from the OFFSETs".to_string(),
+            RestSource::Unrecorded => "rest pose not recorded".to_string(),
+        };
+        let facing = match &rig.facing {
+            Facing::FaceJoints(f) => format!("face joints {}, {}, {}, {}", name(f[0]), name(f[1]), name(f[2]), name(f[3])),
+            Facing::BodyAxis { front, back } => format!("body axis {} -> {}", name(*back), name(*front)),
+        };
+        format!("{rest}; {facing} ({}); {} foot joint(s) ({}); scale {:.6}", how(rig.facing_source), rig.feet.len(), how(rig.feet_source), rig.scale_factor)
+    }
 }
 
 #[cfg(test)]

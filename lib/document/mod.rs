@@ -7,10 +7,12 @@
 //! Later versions add optional fields (feature statistics, the rest-pose feature row);
 //! readers ignore fields they do not know.
 
+mod text;
+
 use crate::bvh::Bvh;
 use crate::bvh::Channel;
 use crate::motion::Motion;
-use crate::repr::anytop::{AnyTopError, AnyTopOptions, AnyTopRig, AnyTopStats, RestSource, FEATURE_DIMS};
+use crate::repr::anytop::{AnyTopError, AnyTopRig, AnyTopStats, RestSource, RigOptions, FEATURE_DIMS};
 use crate::skeleton::names::{self, Side};
 use crate::skeleton::roles::{self, FootRule};
 use crate::skeleton::{topology, Joint, Skeleton, Stats};
@@ -55,7 +57,7 @@ pub struct AnyTopSection {
 impl AnyTopSection {
     /// Rig and P_S from `rest` (its frame 0 is the rest pose, frame 1 gives P_S its velocity),
     /// without statistics.
-    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &AnyTopOptions) -> Result<AnyTopSection, AnyTopError> {
+    pub fn new(skeleton: &Skeleton, rest: &Motion, options: &RigOptions) -> Result<AnyTopSection, AnyTopError> {
         let rig = AnyTopRig::new(skeleton, rest, options)?;
         let row = rig.rest_features(skeleton, rest)?;
         let rest_row = (0..row.joints).map(|j| row.at(0, j).to_vec()).collect();
@@ -82,13 +84,30 @@ impl AnyTopSection {
     /// The record of a lone clip: the rig on its own first two frames (AnyTop's rule without a
     /// T-pose file, the rig `mo-encode` builds for a single input), no statistics.
     pub fn of_clip(skeleton: &Skeleton, motion: &Motion, file: &str) -> Result<AnyTopSection, AnyTopError> {
-        let options = AnyTopOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..AnyTopOptions::default() };
+        let options = RigOptions { rest_source: RestSource::FirstClip { file: file.to_string() }, ..RigOptions::default() };
         AnyTopSection::new(skeleton, &motion.first_frames(2), &options)
+    }
+
+    /// The record `skel-info` gives a motion file (`name`; its motion may have no frames): the
+    /// rest pose is frame 0 of `rest` when given (a file of the same skeleton and its motion),
+    /// else of the file itself (named like a T-pose or not: AnyTop's rule), else the OFFSET pose;
+    /// statistics over the file's motion.
+    pub fn of_file(skeleton: &Skeleton, motion: &Motion, name: &str, rest: Option<(&str, &Motion)>) -> Result<AnyTopSection, AnyTopError> {
+        let (rest, source) = match rest {
+            Some((file, rest)) => (rest.clone(), RestSource::Explicit { file: file.to_string() }),
+            None if motion.frames > 0 => {
+                let file = name.to_string();
+                let source = if crate::motion::clip::names_tpose(&file) { RestSource::TPose { file } } else { RestSource::FirstClip { file } };
+                (motion.first_frames(2), source)
+            }
+            None => (Motion::rest(skeleton), RestSource::Offsets),
+        };
+        AnyTopSection::build(skeleton, &rest, source, &[motion])
     }
 
     /// `new` with default options, plus statistics over `clips` (those with at least two frames).
     pub fn build(skeleton: &Skeleton, rest: &Motion, source: RestSource, clips: &[&Motion]) -> Result<AnyTopSection, AnyTopError> {
-        let options = AnyTopOptions { rest_source: source, ..AnyTopOptions::default() };
+        let options = RigOptions { rest_source: source, ..RigOptions::default() };
         let mut section = AnyTopSection::new(skeleton, rest, &options)?;
         let mut features = Vec::new();
         for clip in clips.iter().filter(|m| m.frames >= 2) {

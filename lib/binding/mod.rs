@@ -8,6 +8,7 @@
 //! namespace, normalised name; never substrings), and a pair order is kept as written.
 
 pub mod auto;
+pub mod clips;
 
 use crate::skeleton::{lookup, Skeleton};
 use serde::{Deserialize, Serialize};

@@ -1,0 +1,74 @@
+//! What the tools write, written one way: the refusal to put binary on a terminal, feature
+//! batches as one NPY, all-or-nothing writes of several files, numbered file patterns, and
+//! messages on stderr that start with the tool's name.
+//!
+//! Each of these was once copied into every tool that needed it, and the copies drifted (one
+//! tool wrote all-or-nothing, the others file by file); here there is one of each.
+
+use crate::io::{self, npy};
+use crate::repr::Features;
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+
+/// Refuse to write binary (`what`, e.g. "NPY") to a terminal: never wanted, and it can upset
+/// the terminal. `hint` says what to do instead.
+pub fn refuse_terminal(output: Option<&Path>, what: &str, hint: &str) -> anyhow::Result<()> {
+    Ok(io::refuse_terminal(output, what, hint)?)
+}
+
+/// One NPY of feature tensors of one shape: `[frames, joints, dims]` for a single tensor unless
+/// `always_batch`, else `[count, frames, joints, dims]`.
+pub fn features_npy(features: &[Features], always_batch: bool) -> anyhow::Result<Vec<u8>> {
+    let first = features.first().context("no features to write")?;
+    let mut shape = first.shape().to_vec();
+    if always_batch || features.len() > 1 {
+        shape.insert(0, features.len());
+    }
+    let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
+    let mut bytes = Vec::new();
+    npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
+    Ok(bytes)
+}
+
+/// Write every output or none: files atomically, stdout (`None` or `-`) last, since it cannot
+/// be taken back; when a file cannot be written, the files of this call already written are
+/// removed.
+pub fn write_all(outputs: &[(Option<PathBuf>, Vec<u8>)]) -> anyhow::Result<()> {
+    Ok(io::write_all(&outputs.iter().map(|(p, b)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?)
+}
+
+/// `count` file names from a pattern with `{i}` (or one name for one file).
+pub fn numbered(pattern: &Path, count: usize) -> anyhow::Result<Vec<PathBuf>> {
+    (0..count).map(|i| io::numbered_output(pattern, i, count).map_err(anyhow::Error::msg)).collect()
+}
+
+/// Messages on stderr, each starting with the tool's name, as `-q` and `-v` allow.
+#[derive(Clone, Copy, Debug)]
+pub struct Say {
+    pub tool: &'static str,
+    pub quiet: bool,
+    pub verbose: bool,
+}
+
+impl Say {
+    /// Something the user should know about the result (not with `-q`).
+    pub fn warn(&self, message: impl std::fmt::Display) {
+        if !self.quiet {
+            eprintln!("{}: warning: {message}", self.tool);
+        }
+    }
+
+    /// A remark that is no warning (not with `-q`).
+    pub fn note(&self, message: impl std::fmt::Display) {
+        if !self.quiet {
+            eprintln!("{}: note: {message}", self.tool);
+        }
+    }
+
+    /// What is happening (only with `-v`).
+    pub fn info(&self, message: impl std::fmt::Display) {
+        if self.verbose {
+            eprintln!("{}: {message}", self.tool);
+        }
+    }
+}
