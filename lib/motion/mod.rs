@@ -5,6 +5,7 @@
 //! and following Blender's importer a joint's position channels *replace* its OFFSET (missing
 //! components are zero). Joints without position channels translate by their OFFSET.
 
+pub mod ik;
 pub mod rotation;
 
 use crate::bvh::Bvh;
