@@ -23,7 +23,7 @@ EXAMPLES:
     mo-edit axis examples/data/dragon.bvh --from y-up --to z-up | mo-edit axis --from z-up --to y-up
     mo-edit scale examples/data/bird.bvh --to-units cm --from-units m -o bird_cm.bvh
     mo-edit rest examples/data/spider.bvh --frame 10 | mo-edit rename --normalise
-    mo-edit root examples/data/biped.bvh --path examples/data/quadruped.bvh -o biped_path.bvh
+    mo-edit in-place examples/data/biped.bvh | mo-edit root --path examples/data/biped.bvh -o b.bvh
     mo-edit foot-lock examples/data/quadruped.bvh -v -o quad_locked.bvh
     mo-edit convert examples/data/fish.bvh --format npy > fish.npy";
 
