@@ -64,9 +64,15 @@ pub enum OutFormat {
 #[derive(clap::Subcommand, Debug)]
 pub enum Command {
     /// Change the format only.
-    Convert { #[arg(default_value = "-")] input: PathBuf },
+    Convert {
+        #[arg(default_value = "-")]
+        input: PathBuf,
+    },
     /// New frame rate (the global --fps): rotations slerped, positions interpolated.
-    Resample { #[arg(default_value = "-")] input: PathBuf },
+    Resample {
+        #[arg(default_value = "-")]
+        input: PathBuf,
+    },
     /// Keep a range of frames (--frames A:B) or seconds (--seconds S:E), both ends included.
     Trim {
         #[arg(default_value = "-")]
@@ -94,7 +100,10 @@ pub enum Command {
         blend: f64,
     },
     /// Swap left and right (skel-info's sides; partners by name, else by mirrored rest position).
-    Mirror { #[arg(default_value = "-")] input: PathBuf },
+    Mirror {
+        #[arg(default_value = "-")]
+        input: PathBuf,
+    },
     /// Re-express rest pose and motion in another axis convention (forward: +z for y-up, -y for z-up).
     Axis {
         #[arg(default_value = "-")]

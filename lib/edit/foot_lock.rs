@@ -58,7 +58,9 @@ pub fn foot_lock(skeleton: &Skeleton, motion: &Motion, options: &PhysicsOptions,
     }
     let clip = Clip::from_motion(skeleton, motion);
     if clip.feet.is_empty() {
-        return Err(EditError::Skeleton("the skeleton has no feet (no joint is named like a foot or toe, nor lies on the ground in the rest pose)".to_string()));
+        return Err(EditError::Skeleton(
+            "the skeleton has no feet (no joint is named like a foot or toe, nor lies on the ground in the rest pose)".to_string(),
+        ));
     }
     let before = physics::physics(&clip, options).map_err(|e| EditError::Invalid(e.to_string()))?;
     let rows = physics::contacts(&clip, options);

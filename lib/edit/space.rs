@@ -207,11 +207,15 @@ pub fn partners(skeleton: &Skeleton) -> Result<(Vec<usize>, usize), EditError> {
         } else {
             let mut mirrored = pos[l];
             mirrored[lateral] = 2.0 * pos[0][lateral] - mirrored[lateral];
-            rights.iter().copied().filter(|&r| !taken[r] && depths[r] == depths[l] && pos[r].distance(mirrored) < tolerance).min_by(|&a, &b| {
-                pos[a].distance(mirrored).total_cmp(&pos[b].distance(mirrored))
-            })
+            rights
+                .iter()
+                .copied()
+                .filter(|&r| !taken[r] && depths[r] == depths[l] && pos[r].distance(mirrored) < tolerance)
+                .min_by(|&a, &b| pos[a].distance(mirrored).total_cmp(&pos[b].distance(mirrored)))
         };
-        let r = found.ok_or_else(|| EditError::Skeleton(format!("left joint {l} '{}' has no right partner (by name or mirrored rest position)", skeleton.joints[l].name)))?;
+        let r = found.ok_or_else(|| {
+            EditError::Skeleton(format!("left joint {l} '{}' has no right partner (by name or mirrored rest position)", skeleton.joints[l].name))
+        })?;
         taken[r] = true;
         partner[l] = r;
         partner[r] = l;

@@ -83,7 +83,8 @@ pub fn span_frames(motion: &Motion, span: Span, seconds: bool) -> Result<(usize,
     let end = span.end.map(to_frame).unwrap_or(last as f64);
     let describe = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v}{unit}"));
     let text = format!("{}:{}", describe(span.start), describe(span.end));
-    let length = if seconds { format!("{:.4} s ({} frames)", last as f64 * motion.frame_time, motion.frames) } else { format!("{} frames (0:{last})", motion.frames) };
+    let length =
+        if seconds { format!("{:.4} s ({} frames)", last as f64 * motion.frame_time, motion.frames) } else { format!("{} frames (0:{last})", motion.frames) };
     if motion.frames == 0 {
         return Err(EditError::Range(format!("range {text}: the clip has no frames")));
     }

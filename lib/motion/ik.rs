@@ -27,4 +27,3 @@ pub fn aim(from: DVec3, from_ref: DVec3, to: DVec3, to_ref: DVec3) -> DQuat {
     };
     DQuat::from_mat3(&(frame(to, to_ref) * frame(from, from_ref).transpose())).normalize()
 }
-

@@ -104,7 +104,8 @@ fn check_all(cases: Vec<Case>) {
     assert!(failures.is_empty(), "{} of {} cases failed:\n{}", failures.len(), cases.len(), failures.join("\n"));
 }
 
-const TOOLS: [&str; 11] = ["skel-info", "skel-aug", "mo-encode", "mo-retarget", "mo-metrics", "mo-render", "mo-train", "mo-sample", "mo-dift", "mo-segment", "mo-edit"];
+const TOOLS: [&str; 11] =
+    ["skel-info", "skel-aug", "mo-encode", "mo-retarget", "mo-metrics", "mo-render", "mo-train", "mo-sample", "mo-dift", "mo-segment", "mo-edit"];
 
 #[test]
 fn usage_errors_are_one_line() {

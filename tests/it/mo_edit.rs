@@ -243,11 +243,7 @@ fn gltf_in_edit_gltf_out_and_back() {
 fn foot_lock_lowers_skating_of_a_retargeted_clip() {
     let dir = tempdir("mo-edit-foot-lock");
     let retargeted = dir.join("quadruped.bvh");
-    let out = run(
-        "mo-retarget",
-        &[s(&example("biped.bvh")), s(&example("quadruped.bvh")), "--bind", "auto", "-o", s(&retargeted)],
-        None,
-    );
+    let out = run("mo-retarget", &[s(&example("biped.bvh")), s(&example("quadruped.bvh")), "--bind", "auto", "-o", s(&retargeted)], None);
     ok(&out, "mo-retarget");
     let locked = dir.join("locked.bvh");
     let report = run("mo-edit", &["foot-lock", s(&retargeted), "-v", "-o", s(&locked)], None);
