@@ -4,8 +4,11 @@
 //! Contacts are found by the very rule `mo-metrics physics` scores with
 //! (`metrics::physics::contacts`: near the ground and slow), so what is locked is what the
 //! metric calls a contact. During each contact the foot is held at its mean position over the
-//! contact; `blend` frames before and after, the target eases from the foot's own position to
-//! the pinned one and back. The foot's parent and grandparent (knee and hip, whatever the
+//! contact. Between two contacts the foot follows its own path plus an offset that eases from
+//! the first pin's to the second's over the whole time between them, so the catch-up happens
+//! mostly in the air (sliding it into a few frames near the ground would be skating again);
+//! before the first contact and after the last, the offset eases in and out over `blend`
+//! frames. The foot's parent and grandparent (knee and hip, whatever the
 //! creature calls them) are turned by two-bone IK (`motion::ik`), bending in the plane they
 //! already bend in; the foot keeps its world rotation. Nothing above the hip moves.
 
@@ -46,8 +49,8 @@ struct Leg {
     foot: usize,
     knee: usize,
     hip: usize,
-    /// Per frame: how much of the pin applies (0..1) and where the pin is.
-    pins: Vec<(f64, DVec3)>,
+    /// Per frame, where the foot should be (`None`: where it is).
+    targets: Vec<Option<DVec3>>,
 }
 
 /// Lock the feet of `motion` (contacts by `options`, `blend` frames of easing on each side).
@@ -80,7 +83,7 @@ pub fn foot_lock(skeleton: &Skeleton, motion: &Motion, options: &PhysicsOptions,
                 used[hip] = true;
                 used[foot] = true;
                 let track: Vec<DVec3> = (0..motion.frames).map(|f| clip.at(f, foot)).collect();
-                legs.push(Leg { foot, knee, hip, pins: pins(row, &track, blend) });
+                legs.push(Leg { foot, knee, hip, targets: targets(row, &track, blend) });
             }
             _ => skipped.push(skeleton.joints[foot].name.clone()),
         }
@@ -91,14 +94,10 @@ pub fn foot_lock(skeleton: &Skeleton, motion: &Motion, options: &PhysicsOptions,
     let n = motion.joints;
     for leg in &legs {
         for f in 0..motion.frames {
-            let (weight, pin) = leg.pins[f];
-            if weight <= 0.0 {
-                continue;
-            }
+            let Some(target) = leg.targets[f] else { continue };
             let at = |j: usize| world.positions[f * n + j];
             let rot = |j: usize| world.rotations[f * n + j];
             let (h, k, foot) = (at(leg.hip), at(leg.knee), at(leg.foot));
-            let target = foot.lerp(pin, weight);
             let (l1, l2) = ((k - h).length(), (foot - k).length());
             if l1 < 1e-9 || l2 < 1e-9 {
                 continue;
@@ -159,12 +158,14 @@ fn arc(from: DVec3, to: DVec3) -> DQuat {
     }
 }
 
-/// Per frame, the weight and position of the pin: each contact (a run of `true` in `row`)
-/// pins at the foot's mean position over it, with weight 1 inside and easing to 0 over
-/// `blend` frames on each side; where two contacts' easings meet, the stronger one holds.
-fn pins(row: &[bool], track: &[DVec3], blend: usize) -> Vec<(f64, DVec3)> {
+/// Per frame, where the foot should be: each contact (a run of `true` in `row`) holds the
+/// foot at its mean position over the contact; between contacts the foot's own path is
+/// shifted by an offset easing from one contact's to the next's; `blend` frames before the
+/// first and after the last contact ease the offset from and to nothing.
+fn targets(row: &[bool], track: &[DVec3], blend: usize) -> Vec<Option<DVec3>> {
     let n = row.len().min(track.len());
-    let mut out: Vec<(f64, DVec3)> = (0..n).map(|f| (0.0, track[f])).collect();
+    // Contacts as (first, last, pin).
+    let mut contacts = Vec::new();
     let mut f = 0;
     while f < n {
         if !row[f] {
@@ -175,15 +176,34 @@ fn pins(row: &[bool], track: &[DVec3], blend: usize) -> Vec<(f64, DVec3)> {
         while f < n && row[f] {
             f += 1;
         }
-        let end = f - 1;
-        let pin = track[start..=end].iter().copied().sum::<DVec3>() / (end - start + 1) as f64;
-        let lo = start.saturating_sub(blend);
-        let hi = (end + blend).min(n - 1);
-        for (g, slot) in out.iter_mut().enumerate().take(hi + 1).skip(lo) {
-            let away = if g < start { start - g } else { g.saturating_sub(end) };
-            let w = 0.5 * (1.0 + (std::f64::consts::PI * away as f64 / (blend + 1) as f64).cos());
-            if w > slot.0 {
-                *slot = (w, pin);
+        let pin = track[start..f].iter().copied().sum::<DVec3>() / (f - start) as f64;
+        contacts.push((start, f - 1, pin));
+    }
+    let mut out = vec![None; n];
+    let ease = |t: f64| 0.5 - 0.5 * (std::f64::consts::PI * t.clamp(0.0, 1.0)).cos();
+    for (i, &(start, end, pin)) in contacts.iter().enumerate() {
+        for slot in out.iter_mut().take(end + 1).skip(start) {
+            *slot = Some(pin);
+        }
+        let offset_out = pin - track[end];
+        match contacts.get(i + 1) {
+            Some(&(next, _, next_pin)) => {
+                let offset_in = next_pin - track[next];
+                for g in end + 1..next {
+                    let t = (g - end) as f64 / (next - end) as f64;
+                    out[g] = Some(track[g] + offset_out.lerp(offset_in, ease(t)));
+                }
+            }
+            None => {
+                for g in end + 1..(end + 1 + blend).min(n) {
+                    out[g] = Some(track[g] + offset_out * (1.0 - ease((g - end) as f64 / (blend + 1) as f64)));
+                }
+            }
+        }
+        if i == 0 {
+            let offset_in = pin - track[start];
+            for g in start.saturating_sub(blend)..start {
+                out[g] = Some(track[g] + offset_in * (1.0 - ease((start - g) as f64 / (blend + 1) as f64)));
             }
         }
     }
@@ -195,14 +215,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn pins_hold_inside_contacts_and_ease_out() {
-        let track: Vec<DVec3> = (0..10).map(|f| DVec3::new(f as f64, 0.0, 0.0)).collect();
-        let row = [false, false, true, true, true, false, false, false, false, false];
-        let p = pins(&row, &track, 1);
-        assert_eq!(p[3], (1.0, DVec3::new(3.0, 0.0, 0.0)));
-        // One frame of easing on each side: halfway there, and nothing beyond.
-        assert_eq!((p[1].0, p[5].0), (0.5, 0.5));
-        assert_eq!((p[0].0, p[6].0), (0.0, 0.0));
+    fn feet_hold_in_contacts_and_catch_up_between_them() {
+        let track: Vec<DVec3> = (0..12).map(|f| DVec3::new(f as f64, 0.0, 0.0)).collect();
+        let row = [false, false, true, true, true, false, false, false, true, true, false, false];
+        let p = targets(&row, &track, 1);
+        // Held at the mean of each contact.
+        assert_eq!(p[2..5], [Some(DVec3::new(3.0, 0.0, 0.0)); 3]);
+        assert_eq!(p[8..10], [Some(DVec3::new(8.5, 0.0, 0.0)); 2]);
+        // One frame of easing before the first and after the last contact, nothing beyond.
+        assert!((p[1].unwrap().x - 1.5).abs() < 1e-12 && (p[10].unwrap().x - 9.75).abs() < 1e-12, "{p:?}");
+        assert_eq!((p[0], p[11]), (None, None));
+        // Between contacts the offset eases from -1 (after the first) to +0.5 (before the second).
+        let gap: Vec<f64> = (4..=8).map(|f| p[f].unwrap().x - track[f].x).collect();
+        assert!(gap.windows(2).all(|w| w[1] >= w[0]), "{gap:?}");
     }
 
     #[test]
