@@ -282,19 +282,8 @@ fn edit_one(command: &Command, c: &BvhClip, verbose: bool) -> Result<(Skeleton, 
             let options = physics_options(*ground, *contact_height, *contact_speed).map_err(|e| EditError::Invalid(e.to_string()))?;
             let (out, report) = edit::foot_lock::foot_lock(s, m, &options, frames(*blend, m))?;
             if verbose {
-                let show = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
-                eprintln!(
-                    "mo-edit: foot-lock: skating {} -> {} sizes/s; legs moved at most {:.4} sizes, the rest {:.4}",
-                    show(report.skating_before),
-                    show(report.skating_after),
-                    report.legs_moved,
-                    report.rest_moved
-                );
-                for f in &report.feet {
-                    eprintln!("mo-edit: foot-lock: {}: {} contacts, {} frames", f.name, f.contacts, f.contact_frames);
-                }
-                if !report.skipped.is_empty() {
-                    eprintln!("mo-edit: foot-lock: not locked (no hip and knee above them): {}", report.skipped.join(", "));
+                for line in report.lines() {
+                    eprintln!("mo-edit: foot-lock: {line}");
                 }
             }
             keep(out)

@@ -37,6 +37,26 @@ pub struct FootLockReport {
     pub rest_moved: f64,
 }
 
+impl FootLockReport {
+    /// The report for people, one line each: the skating and how far things moved, then
+    /// each locked foot, then the feet not locked.
+    pub fn lines(&self) -> Vec<String> {
+        let show = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
+        let mut out = vec![format!(
+            "skating {} -> {} sizes/s; legs moved at most {:.4} sizes, the rest {:.4}",
+            show(self.skating_before),
+            show(self.skating_after),
+            self.legs_moved,
+            self.rest_moved
+        )];
+        out.extend(self.feet.iter().map(|f| format!("{}: {} contacts, {} frames", f.name, f.contacts, f.contact_frames)));
+        if !self.skipped.is_empty() {
+            out.push(format!("not locked (no hip and knee above them): {}", self.skipped.join(", ")));
+        }
+        out
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct LockedFoot {
     pub name: String,
