@@ -35,6 +35,8 @@
 //! * [`genmm`]: example-based generation from a few clips of a skeleton, no training (GenMM).
 //! * [`retarget`]: Motion2Motion retargeting (patch nearest neighbours over a pyramid).
 //! * [`metrics`]: the papers' metrics, movement and physics scores.
+//! * [`edit`]: the everyday edits of a clip (`mo-edit`): time, axes, scale, mirror, root, rest
+//!   pose, names, foot locking.
 //! * [`segment`]: temporal segmentation of a motion into actions.
 //! * [`render`]: contact sheets (PNG), GIF and an HTML viewer.
 //! * [`synth`]: procedural creatures and gaits, the project's own example data.
@@ -51,6 +53,7 @@ pub mod correspond;
 pub mod diffusion;
 pub mod dift;
 pub mod document;
+pub mod edit;
 pub mod embed;
 pub mod genmm;
 pub mod gltf;

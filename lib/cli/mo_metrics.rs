@@ -225,7 +225,7 @@ pub enum GroundArg {
     Height(f64),
 }
 
-fn parse_ground(s: &str) -> Result<GroundArg, String> {
+pub fn parse_ground(s: &str) -> Result<GroundArg, String> {
     match s {
         "zero" => Ok(GroundArg::Zero),
         "estimate" => Ok(GroundArg::Estimate),
@@ -297,7 +297,7 @@ fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: boo
     Ok(report)
 }
 
-fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -> anyhow::Result<PhysicsOptions> {
+pub fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -> anyhow::Result<PhysicsOptions> {
     if !(contact_height.is_finite() && contact_height > 0.0) || !(contact_speed.is_finite() && contact_speed > 0.0) {
         bail!("--contact-height and --contact-speed must be positive numbers");
     }

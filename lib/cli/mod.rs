@@ -11,6 +11,7 @@ pub mod docs;
 pub mod latent;
 pub mod load;
 pub mod mo_dift;
+pub mod mo_edit;
 pub mod mo_encode;
 pub mod mo_metrics;
 pub mod mo_render;
@@ -167,5 +168,6 @@ pub fn all_commands() -> Vec<clap::Command> {
         mo_sample::Args::command(),
         mo_dift::Args::command(),
         mo_segment::Args::command(),
+        mo_edit::Args::command(),
     ]
 }

@@ -44,7 +44,7 @@
 //! * the example pyramid follows the synthesis's time scale at every level (as in `retarget`),
 //!   so an output longer than the examples has proportionally longer levels.
 
-mod heading;
+pub(crate) mod heading;
 #[cfg(test)]
 mod tests;
 

@@ -76,6 +76,15 @@ fn decompose_tait_bryan(q: DQuat, [i, j, k]: [usize; 3]) -> [f64; 3] {
     [a.to_degrees(), b.to_degrees(), c.to_degrees()]
 }
 
+/// The mirror image of a rotation across the plane through the origin normal to `axis`
+/// (0 = x, 1 = y, 2 = z): for a reflection M, the rotation M q M. Its axis is reflected and
+/// its sense reversed, so the component along `axis` stays and the other two change sign.
+pub fn reflect(q: DQuat, axis: usize) -> DQuat {
+    let mut v = [-q.x, -q.y, -q.z];
+    v[axis.min(2)] = -v[axis.min(2)];
+    DQuat::from_xyzw(v[0], v[1], v[2], q.w)
+}
+
 /// Axes of the rotation channels of a joint, in channel order.
 pub fn rotation_axes(channels: &[Channel]) -> Vec<usize> {
     channels.iter().filter(|c| c.is_rotation()).map(|c| c.axis()).collect()

@@ -211,6 +211,12 @@ pub fn side_from_name(normalised: &str) -> Option<Side> {
     }
 }
 
+/// The key that left and right partners share: the raw name without namespace, Truebones
+/// suffix and side words, lower case.
+pub fn mirror_key(raw: &str) -> String {
+    split_words(raw).into_iter().map(|w| w.to_lowercase()).filter(|w| !matches!(w.as_str(), "l" | "r" | "left" | "right")).collect::<Vec<_>>().join("_")
+}
+
 #[cfg(test)]
 mod tests {
     use super::{normalise, readable};

@@ -33,6 +33,7 @@ mod route;
 mod training;
 mod undulating;
 
+pub(crate) use crate::motion::ik::{aim, two_bone_knee};
 pub(crate) use rig::human_name;
 pub use rig::{rig, Naming, Rig, UpAxis, RIG_VARIANTS};
 pub use training::{actions, proportions, training_clip, write_training_zoo, Action, Proportions, TrainingClip, CLIP_FRAMES};
@@ -48,7 +49,7 @@ use crate::bvh::{self, Bvh, Channel};
 use crate::motion::Motion;
 use crate::rng::SplitMix64;
 use crate::skeleton::{Joint, Skeleton};
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DQuat, DVec3};
 use std::f64::consts::TAU;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -370,34 +371,10 @@ pub(crate) fn animate(skel: &Skeleton, frames: usize, mut pose_at: impl FnMut(&m
     motion
 }
 
-/// Where the middle joint of a two-bone chain goes: the law of cosines in the plane of
-/// `hip -> target` and `pole`. Out-of-reach targets are pulled in just short of a straight
-/// limb, so the solve never produces NaN and knees never snap through.
-pub(crate) fn two_bone_knee(hip: DVec3, target: DVec3, l1: f64, l2: f64, pole: DVec3) -> DVec3 {
-    let to = target - hip;
-    let dir = to.try_normalize().unwrap_or(DVec3::NEG_Y);
-    let d = to.length().clamp((l1 - l2).abs() + 1e-6, (l1 + l2) * 0.9999);
-    let a = (l1 * l1 - l2 * l2 + d * d) / (2.0 * d);
-    let h = (l1 * l1 - a * a).max(0.0).sqrt();
-    let side = (pole - dir * dir.dot(pole)).try_normalize().unwrap_or_else(|| dir.any_orthonormal_vector());
-    hip + dir * a + side * h
-}
-
-/// The rotation taking direction `from` to `to` while taking the reference `from_ref` to
-/// `to_ref` as closely as possible (both references are made perpendicular first).
-pub(crate) fn aim(from: DVec3, from_ref: DVec3, to: DVec3, to_ref: DVec3) -> DQuat {
-    let frame = |x: DVec3, r: DVec3| {
-        let x = x.normalize();
-        let y = (r - x * x.dot(r)).try_normalize().unwrap_or_else(|| x.any_orthonormal_vector());
-        DMat3::from_cols(x, y, x.cross(y))
-    };
-    DQuat::from_mat3(&(frame(to, to_ref) * frame(from, from_ref).transpose())).normalize()
-}
-
 /// The mirror image of a rotation across the x = 0 plane: what the right side does when the
 /// left side does `q`.
 pub(crate) fn mirror(q: DQuat) -> DQuat {
-    DQuat::from_xyzw(q.x, -q.y, -q.z, q.w)
+    crate::motion::rotation::reflect(q, 0)
 }
 
 pub(crate) fn rx(deg: f64) -> DQuat {

@@ -104,7 +104,8 @@ fn check_all(cases: Vec<Case>) {
     assert!(failures.is_empty(), "{} of {} cases failed:\n{}", failures.len(), cases.len(), failures.join("\n"));
 }
 
-const TOOLS: [&str; 10] = ["skel-info", "skel-aug", "mo-encode", "mo-retarget", "mo-metrics", "mo-render", "mo-train", "mo-sample", "mo-dift", "mo-segment"];
+const TOOLS: [&str; 11] =
+    ["skel-info", "skel-aug", "mo-encode", "mo-retarget", "mo-metrics", "mo-render", "mo-train", "mo-sample", "mo-dift", "mo-segment", "mo-edit"];
 
 #[test]
 fn usage_errors_are_one_line() {
@@ -112,7 +113,11 @@ fn usage_errors_are_one_line() {
     let b = s(&biped);
     let mut cases = Vec::new();
     for tool in TOOLS {
-        let input: &[&str] = if tool == "mo-metrics" { &["physics", b] } else { &[b] };
+        let input: &[&str] = match tool {
+            "mo-metrics" => &["physics", b],
+            "mo-edit" => &["convert", b],
+            _ => &[b],
+        };
         cases.push(case("unknown flag", tool, &["--no-such-flag"], &["--no-such-flag", "(see --help)"]));
         cases.push(case("--threads 0", tool, &[input, &["--threads", "0"]].concat(), &["--threads", "(see --help)"]));
         cases.push(case("--threads huge", tool, &[input, &["--threads", "100000"]].concat(), &["--threads", "(see --help)"]));
@@ -363,6 +368,7 @@ fn writers(out: &Path, dir: &Path) -> Vec<(&'static str, Vec<String>)> {
         ("mo-sample", v(&[&b, "--frames", "4", "--steps", "1", "-o", &o])),
         ("mo-dift", v(&[&b, "--draws", "1", "-o", &o])),
         ("mo-segment", v(&[&b, "--features", "raw", "-o", &o])),
+        ("mo-edit", v(&["convert", &b, "-o", &o])),
     ]
 }
 

@@ -15,6 +15,7 @@ mod malformed;
 mod metrics_corpus;
 mod metrics_fid_numpy;
 mod mo_dift_cli;
+mod mo_edit;
 mod mo_encode_anytop;
 mod mo_encode_m2m;
 mod mo_metrics_cli;

@@ -395,17 +395,6 @@ fn mean_offset_length(skeleton: &Skeleton) -> Result<f64, AnyTopError> {
     }
 }
 
-/// The key that left and right partners share: the raw name without namespace, Truebones
-/// suffix and side words, lower case.
-fn mirror_key(raw: &str) -> String {
-    crate::skeleton::names::split_words(raw)
-        .into_iter()
-        .map(|w| w.to_lowercase())
-        .filter(|w| !matches!(w.as_str(), "l" | "r" | "left" | "right"))
-        .collect::<Vec<_>>()
-        .join("_")
-}
-
 /// The automatic facing rule (module doc).
 pub(super) fn automatic_facing(skeleton: &Skeleton, p0: &[DVec3], feet: &[usize]) -> Facing {
     let n = skeleton.len();
@@ -440,7 +429,7 @@ pub(super) fn automatic_facing(skeleton: &Skeleton, p0: &[DVec3], feet: &[usize]
     let limb_roots: Vec<usize> = (0..n).filter(|&j| lateral(j) && parents[j].is_none_or(|p| !lateral(p))).collect();
     let lefts: Vec<usize> = limb_roots.iter().copied().filter(|&j| sides[j] == Side::Left).collect();
     let rights: Vec<usize> = limb_roots.iter().copied().filter(|&j| sides[j] == Side::Right).collect();
-    let keys: Vec<String> = skeleton.joints.iter().map(|j| mirror_key(&j.name)).collect();
+    let keys: Vec<String> = skeleton.joints.iter().map(|j| names::mirror_key(&j.name)).collect();
     let mut used = vec![false; n];
     let mut pairs: Vec<(usize, usize)> = Vec::new(); // (right, left)
     let mut unpaired = Vec::new();
@@ -578,7 +567,7 @@ impl AnyTopRig {
 
 #[cfg(test)]
 mod tests {
-    use super::mirror_key;
+    use crate::skeleton::names::mirror_key;
 
     #[test]
     fn mirror_keys_agree_across_sides() {

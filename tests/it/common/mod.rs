@@ -74,6 +74,7 @@ pub fn bin(name: &str) -> Command {
         "mo-sample" => env!("CARGO_BIN_EXE_mo-sample"),
         "mo-dift" => env!("CARGO_BIN_EXE_mo-dift"),
         "mo-segment" => env!("CARGO_BIN_EXE_mo-segment"),
+        "mo-edit" => env!("CARGO_BIN_EXE_mo-edit"),
         other => panic!("unknown binary {other}"),
     };
     let mut c = Command::new(path);
