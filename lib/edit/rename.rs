@@ -3,8 +3,8 @@
 //! Rigs from different tools name one bone `mixamorig:LeftUpLeg`, `Bip01_L_Thigh` and
 //! `thigh.L`; game engines and retargeting setups want their own names. A map says old -> new
 //! for some joints; `--normalise` uses the readable names `skel-info` prints
-//! (`names::normalise`), written without spaces (`LeftUpLeg`) so every tool takes them, made
-//! unique with a number where two joints read the same.
+//! (`names::readable`, ordinals kept: `leg_l1_coxa` -> `LeftLeg1Coxa`), written without spaces
+//! so every tool takes them, made unique with a number where two joints still read the same.
 
 use super::EditError;
 use crate::skeleton::{lookup, names, Skeleton};
@@ -57,11 +57,12 @@ pub fn rename(skeleton: &Skeleton, map: &[(String, String)]) -> Result<Skeleton,
     Ok(s)
 }
 
-/// The skeleton with `names::normalise`d names, spaces dropped, duplicates numbered in joint
-/// order (`LeftLeg`, `LeftLeg2`, ...).
+/// The skeleton with `names::readable` names, spaces dropped, duplicates numbered in joint
+/// order (`LeftLeg`, `LeftLeg2`, ...). Not `names::normalise`: it drops ordinals, so `Spine`,
+/// `Spine1`, `Spine2` would all read `Spine` and be renumbered out of step with their names.
 pub fn normalise(skeleton: &Skeleton) -> Result<Skeleton, EditError> {
     let mut s = skeleton.clone();
-    let base: Vec<String> = skeleton.joints.iter().map(|j| names::normalise(&j.name).split_whitespace().collect::<String>()).collect();
+    let base: Vec<String> = skeleton.joints.iter().map(|j| names::readable(&j.name).split_whitespace().collect::<String>()).collect();
     let mut count: BTreeMap<&str, usize> = BTreeMap::new();
     for b in &base {
         *count.entry(b.as_str()).or_default() += 1;
