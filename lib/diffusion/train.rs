@@ -321,10 +321,12 @@ pub struct StepDraw {
 /// 16-crop group gained only 1.19x from a second core (issue 28). The split depends only on
 /// the crops, never on the thread count, so the bytes stay the same at any `--threads`, and
 /// the model gives a crop the same output in any sub-batch, so only the cost changes.
-/// Why 4: a paper-width sub-batch of 4 crops of 41 frames of a 43-joint creature keeps its
-/// largest activation (7k tokens x ff 1024 floats) under glibc's 32 MiB mmap threshold (see
-/// `nn::keep_freed_memory`), so it is reused instead of page-faulted afresh every step, while
-/// its matmuls still have thousands of rows (measured in BENCHMARKS.md, "Training step").
+/// Why 4: its matmuls still have thousands of rows (4 crops x 41 frames x J joints), and a
+/// paper-width sub-batch's largest activation (7k tokens x ff 1024 floats) stays under glibc's
+/// 32 MiB mmap threshold (see `nn::keep_freed_memory`), so it can be reused rather than mapped
+/// afresh each step. Measured quietly (BENCHMARKS.md, "Sub-batches") only against no split: 4
+/// against 8 was compared under load only, and why one thread got faster as well is not
+/// established.
 pub const MAX_SUB_BATCH: usize = 4;
 
 /// `items` in order, cut into the fewest runs of at most `most` items, of near-equal length

@@ -519,7 +519,7 @@ fn transition(
 /// clip is behind its share: the clip's share of the examples' patches over its share of the
 /// walk so far. Drawn uniformly, the walk drifted toward clips whose poses resemble each
 /// other's (an idle, a stop), where most good jumps lead, and the zoo's samples moved at
-/// 0.72-0.78 of their clips' energy; with one clip every weight is equal.
+/// 0.72-0.77 of their clips' energy; with one clip every weight is equal.
 fn balanced(candidates: &[&(f32, usize, usize)], starts: &[usize], placed: &[usize], rng: &mut SplitMix64) -> usize {
     let total = starts.iter().sum::<usize>().max(1) as f64;
     let walked = placed.iter().sum::<usize>() as f64;
