@@ -25,7 +25,7 @@ function __fish_mo_edit_using_subcommand
 end
 
 complete -c mo-edit -n "__fish_mo_edit_needs_command" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_needs_command" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -52,7 +52,7 @@ complete -c mo-edit -n "__fish_mo_edit_needs_command" -f -a "rename" -d 'Rename 
 complete -c mo-edit -n "__fish_mo_edit_needs_command" -f -a "foot-lock" -d 'Pin feet during contacts (mo-metrics physics\' rule) by two-bone IK; -v reports skating'
 complete -c mo-edit -n "__fish_mo_edit_needs_command" -f -a "help" -d 'Print this message or the help of the given subcommand(s)'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand convert" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand convert" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -64,7 +64,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand convert" -s q -l quiet -
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand convert" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand convert" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand resample" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand resample" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -78,7 +78,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand resample" -s h -l help -
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand trim" -l frames -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand trim" -l seconds -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand trim" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand trim" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -91,7 +91,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand trim" -s v -l verbose -d
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand trim" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand concat" -l blend -d 'Seconds of easing on each side of every seam' -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand concat" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand concat" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -104,7 +104,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand concat" -s v -l verbose 
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand concat" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand loop" -l blend -d 'Seconds of easing on each side of the seam' -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand loop" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand loop" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -116,7 +116,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand loop" -s q -l quiet -d '
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand loop" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand loop" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand mirror" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand mirror" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -132,7 +132,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand axis" -l to -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand axis" -l from-forward -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand axis" -l to-forward -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand axis" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand axis" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -147,7 +147,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -l factor -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -l to-units -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -l from-units -d 'The clip\'s units [default: guessed: cm if it is 20 units or more across, else m]' -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -159,7 +159,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -s q -l quiet -d 
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand scale" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand in-place" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand in-place" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -173,7 +173,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand in-place" -s v -l verbos
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand in-place" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand root" -l path -r -F
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand root" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand root" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -187,7 +187,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand root" -s h -l help -d 'P
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rest" -l frame -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rest" -l t-pose -r -F
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rest" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rest" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -200,7 +200,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand rest" -s v -l verbose -d
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rest" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rename" -l map -r -F
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rename" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rename" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
@@ -217,7 +217,7 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l ground -d 
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l contact-height -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l contact-speed -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
-glb\t'Binary glTF: skin, animation, a stick mesh'
+glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
 npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F

@@ -11,7 +11,7 @@ complete -c mo-retarget -l key-frames -d 'Key-frame mode: the source counts only
 complete -c mo-retarget -l format -d 'Output format on stdout: BVH, glTF (glb: binary, gltf: JSON) or Motion2Motion features (npy). An -o file named .glb or .gltf is written as glTF' -r -f -a "bvh\t''
 glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'
-npy\t'Motion2Motion features'"
+npy\t'Motion2Motion features [frames, joints, 9]'"
 complete -c mo-retarget -l patch -d 'Patch length in frames (paper: 11)' -r
 complete -c mo-retarget -l alpha -d 'Weight of the bound (source) channels in matching, 0..1 (paper: 0.85)' -r
 complete -c mo-retarget -l steps -d 'Match-and-blend iterations per pyramid level (paper: 3)' -r

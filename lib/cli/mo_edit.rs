@@ -3,6 +3,7 @@
 
 use crate::cli::load::{is_dash, motion_bytes, read_bvh_clip, read_example_clips, MotionFormat};
 use crate::cli::mo_metrics::{parse_ground, physics_options, GroundArg};
+use crate::cli::output::OutFormat;
 use crate::cli::{bounds, CommonOpts};
 use crate::edit::space::{Axes, SignedAxis, Units};
 use crate::edit::time::Span;
@@ -49,17 +50,6 @@ pub struct Args {
     pub format: Option<OutFormat>,
     #[command(flatten)]
     pub common: CommonOpts,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum OutFormat {
-    Bvh,
-    /// Binary glTF: skin, animation, a stick mesh.
-    Glb,
-    /// glTF JSON, data inlined.
-    Gltf,
-    /// Motion2Motion features [frames, joints, 9].
-    Npy,
 }
 
 #[derive(clap::Subcommand, Debug)]

@@ -6,8 +6,9 @@
 use crate::binding::auto;
 use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips, MotionFormat};
-use crate::cli::{output, CommonOpts};
+use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips};
+use crate::cli::output::{self, OutFormat};
+use crate::cli::CommonOpts;
 use crate::io;
 use crate::motion::Clip;
 use crate::motion::Motion;
@@ -139,28 +140,6 @@ pub struct Args {
 pub enum Method {
     M2m,
     Latent,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum OutFormat {
-    Bvh,
-    /// Binary glTF (skin, animation, a stick mesh).
-    Glb,
-    /// glTF JSON, data inlined.
-    Gltf,
-    /// Motion2Motion features.
-    Npy,
-}
-
-impl OutFormat {
-    /// The motion file format on stdout (`--format npy` has none).
-    fn motion(self) -> MotionFormat {
-        match self {
-            OutFormat::Glb => MotionFormat::Glb,
-            OutFormat::Gltf => MotionFormat::Gltf,
-            OutFormat::Bvh | OutFormat::Npy => MotionFormat::Bvh,
-        }
-    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]

@@ -10,6 +10,31 @@ use crate::repr::Features;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
+/// A motion output's format, for the tools whose `--format` offers BVH, glTF and Motion2Motion
+/// features (`mo-retarget`, `mo-edit`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutFormat {
+    Bvh,
+    /// Binary glTF (skin, animation, a stick mesh).
+    Glb,
+    /// glTF JSON, data inlined.
+    Gltf,
+    /// Motion2Motion features [frames, joints, 9].
+    Npy,
+}
+
+impl OutFormat {
+    /// The motion file format (`npy` has none: BVH stands in).
+    pub fn motion(self) -> crate::cli::load::MotionFormat {
+        use crate::cli::load::MotionFormat;
+        match self {
+            OutFormat::Glb => MotionFormat::Glb,
+            OutFormat::Gltf => MotionFormat::Gltf,
+            OutFormat::Bvh | OutFormat::Npy => MotionFormat::Bvh,
+        }
+    }
+}
+
 /// Refuse to write binary (`what`, e.g. "NPY") to a terminal: never wanted, and it can upset
 /// the terminal. `hint` says what to do instead.
 pub fn refuse_terminal(output: Option<&Path>, what: &str, hint: &str) -> anyhow::Result<()> {
