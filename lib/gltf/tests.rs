@@ -147,3 +147,25 @@ fn step_rotations_and_cubic_joint_translations_from_a_data_uri() {
     assert!(close(p.position(1, 1), [0.0, 3.0, 0.0]), "{:?}", p.position(1, 1));
     assert!(close(p.position(2, 1), [3.0, 1.0, 0.0]), "{:?}", p.position(2, 1));
 }
+
+/// The stick body: one stick per bone and End Site, base ring on the parent and tip ring on the
+/// child; a child that travels away from its offset (a root-at-origin file keying its hips in
+/// world space) gets none, so viewers show no beam from the world origin to the creature.
+#[test]
+fn sticks_follow_both_ends_and_skip_travelling_children() {
+    let (skeleton, mut motion) = bundled("quadruped.bvh");
+    let rest = Motion::rest(&skeleton).forward_kinematics(&skeleton).positions;
+    let bones = skeleton.joints.iter().filter(|j| j.parent.is_some()).count() + skeleton.joints.iter().map(|j| j.end_sites.len()).sum::<usize>();
+    let all = mesh::sticks(&skeleton, &motion, &rest).unwrap();
+    assert_eq!(all.positions.len(), 8 * bones);
+    let child = 1;
+    let parent = skeleton.joints[child].parent.unwrap();
+    // The first stick is the one into joint 1: four base vertices on its parent, four tip ones on it.
+    assert_eq!(&all.joints[..8], &[parent as u16; 4].iter().chain(&[child as u16; 4]).copied().collect::<Vec<_>>()[..]);
+    for f in 0..motion.frames {
+        motion.translations[f * motion.joints + child] = skeleton.joints[child].offset + glam::DVec3::X * f as f64;
+    }
+    let fewer = mesh::sticks(&skeleton, &motion, &rest).unwrap();
+    assert_eq!(fewer.positions.len(), 8 * (bones - 1));
+    assert!(!fewer.joints.chunks(8).any(|s| s[0] == parent as u16 && s[4] == child as u16));
+}

@@ -100,7 +100,7 @@ fn build(skeleton: &Skeleton, motion: &Motion) -> (json::Root, Vec<u8>) {
     });
 
     let mut scene_nodes = vec![Index::new(0)];
-    if let Some(sticks) = mesh::sticks(skeleton, &rest) {
+    if let Some(sticks) = mesh::sticks(skeleton, motion, &rest) {
         let mesh = b.sticks_mesh(&sticks);
         scene_nodes.push(Index::new(b.root.nodes.len() as u32));
         b.root.nodes.push(json::Node { name: Some("body".to_string()), mesh: Some(mesh), skin: Some(Index::new(0)), ..Default::default() });
