@@ -12,6 +12,7 @@
 
 pub mod correspond;
 pub mod eval;
+pub mod report;
 
 use crate::diffusion::checkpoint::CheckpointInfo;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
