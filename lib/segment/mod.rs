@@ -28,6 +28,7 @@
 //! Everything is sequential f64 arithmetic in a fixed order: same input and seed, same labels.
 
 pub mod input;
+pub mod report;
 mod kmeans;
 mod pca;
 
