@@ -200,11 +200,7 @@ fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
         bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
     }
     let (reference, target) = (&motions[0], &motions[1]);
-    let text = if args.as_binding {
-        report::combined_binding(reference, target, args.bind_rate)?
-    } else {
-        report::combined_joint_matches(reference, target)?
-    };
+    let text = if args.as_binding { report::combined_binding(reference, target, args.bind_rate)? } else { report::combined_joint_matches(reference, target)? };
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
@@ -214,4 +210,3 @@ fn features_of(model: &FrozenDenoiser, m: &Clip, opts: &DiftOptions, device: &De
     let schedule = model.info.schedule();
     dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, device).with_context(|| m.name.clone())
 }
-

@@ -23,14 +23,14 @@
 use crate::cli::load::{is_dash, read_skeleton, split_samples, FeatureDecoder};
 pub use crate::cli::load::{load_skeleton, DecodeFrom, MotionFormat};
 use crate::cli::{output, CommonOpts};
-use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
-use crate::input;
+use crate::document::MotionInfo;
 use crate::io::{self, npy};
-use crate::motion::clip::{self, Clip, RestChoice};
+use crate::motion::clip::Clip;
 use crate::motion::Motion;
-use crate::repr::anytop::{self, placements, AnyTopStats, NamedOverrides, Placement, RestSource};
-use crate::repr::{batch, m2m, Features};
-use crate::skeleton::{topology, Skeleton};
+use crate::repr::anytop::{self, placements, NamedOverrides, Placement};
+use crate::repr::{m2m, Features};
+use crate::skeleton::Skeleton;
+use crate::{encode, input};
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -364,14 +364,9 @@ fn encode(args: &Args) -> anyhow::Result<()> {
     }
 }
 
-/// The names of clips, for batch messages.
-fn names(clips: &[Clip]) -> Vec<&str> {
-    clips.iter().map(|c| c.name.as_str()).collect()
-}
-
 /// One NPY of the clips' features, checked finite first.
 fn npy_bytes(clips: &[Clip], features: &[Features]) -> anyhow::Result<Vec<u8>> {
-    batch::check_finite(&names(clips), clips.iter().map(|c| &c.skeleton), features).map_err(anyhow::Error::msg)?;
+    encode::check_finite(clips, features)?;
     output::features_npy(features, false)
 }
 
@@ -397,9 +392,7 @@ fn check_outputs(args: &Args) -> anyhow::Result<()> {
 
 fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
     let say = args.common.say("mo-encode");
-    let encoded: Vec<(Features, Option<String>)> = clips.par_iter().map(|c| (m2m::encode(&c.motion), m2m::loss_warning(&c.motion, &c.skeleton))).collect();
-    let (features, warnings): (Vec<Features>, Vec<Option<String>>) = encoded.into_iter().unzip();
-    batch::check_stackable(&names(clips), &features).map_err(anyhow::Error::msg)?;
+    let (features, warnings) = encode::m2m(clips)?;
     let first = &clips[0];
     for (clip, (f, warning)) in clips.iter().zip(features.iter().zip(&warnings)) {
         if let Some(w) = warning {
@@ -414,52 +407,20 @@ fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
     output::write_all(&[(args.common.output.clone(), npy_bytes(clips, &features)?)])
 }
 
-/// The rig for encoding, the document that will carry it, and the name of where it came from:
-/// `--skeleton`'s record, else one built on AnyTop's rest pose of the inputs.
-fn encoding_rig(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<(SkeletonDocument, AnyTopSection, String)> {
+fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<()> {
+    let say = args.common.say("mo-encode");
+    encode::check_frames(clips)?;
     let first = &clips[0];
-    for clip in &clips[1..] {
-        input::same_skeleton(&first.name, &first.skeleton, &clip.name, &clip.skeleton)?;
-    }
+    // Checked in this order: the clips, the rest pose, the skeleton file.
+    encode::same_skeleton(clips)?;
     let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?.map(|(clip, _)| clip);
     if let Some(rest) = &rest_pose {
         input::same_skeleton(&first.name, &first.skeleton, &rest.name, &rest.skeleton)?;
     }
-    if let Some(path) = args.skeleton.as_deref() {
-        let file = read_skeleton(path)?;
-        input::same_skeleton(&first.name, &first.skeleton, &file.name, &file.skeleton)?;
-        let want_stats = args.normalise || args.emit_skeleton.is_some();
-        let section = file.record_with(rest_pose.as_ref(), &overrides(args), want_stats)?;
-        return Ok((file.document, section, file.name));
-    }
-    let (rest, choice) = clip::rest_pose(rest_pose.as_ref(), clips).expect("clips is not empty");
-    let file = rest.name.clone();
-    let source = match choice {
-        RestChoice::Explicit => RestSource::Explicit { file },
-        RestChoice::TPose => RestSource::TPose { file },
-        RestChoice::FirstClip => RestSource::FirstClip { file },
-    };
-    let options = overrides(args).resolve(&rest.skeleton, &rest.name, source).map_err(anyhow::Error::msg)?;
-    let section =
-        AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options).with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
-    // The document describes the encoded clips (their frame time), with the rig.
-    let document = SkeletonDocument::build(&first.skeleton, first_info, &first.name, topology::DEFAULT_DMAX);
-    Ok((document, section, rest.name.clone()))
-}
-
-fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<()> {
-    let say = args.common.say("mo-encode");
-    if let Some(clip) = clips.iter().find(|c| c.motion.frames < 2) {
-        bail!(
-            "{}: {} frame(s): AnyTop features need at least two frames (frame t's velocity comes from frame t+1, so F frames give F-1 feature frames; a one-frame rest pose goes to --rest-pose)",
-            clip.name,
-            clip.motion.frames
-        );
-    }
-    let first = &clips[0];
-    let (mut document, mut section, rig_name) = encoding_rig(args, clips, first_info)?;
-    let rig = &section.rig;
-    if rig.feet.is_empty() {
+    let file = args.skeleton.as_deref().map(read_skeleton).transpose()?;
+    let want_stats = args.normalise || args.emit_skeleton.is_some();
+    let mut rig = encode::Rig::choose(clips, first_info, rest_pose.as_ref(), file, &overrides(args), want_stats)?;
+    if rig.section.rig.feet.is_empty() {
         // Contacts are part of every AnyTop token; without feet they are all zero, which is
         // right for a fish but surprising for a walker whose feet the names did not reveal.
         if args.require_contacts {
@@ -467,40 +428,20 @@ fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) ->
         }
         say.warn(format_args!("{}: no foot joints found, so every contact feature is 0 (name them with --feet)", first.name));
     }
-    say.info(format_args!("rig: {}", rig.describe(&first.skeleton)));
-
-    let results: Vec<anyhow::Result<anytop::Encoded>> = clips
-        .par_iter()
-        .map(|c| rig.encode(&c.skeleton, &c.motion).with_context(|| format!("{}: cannot encode with the AnyTop rig of {rig_name}", c.name)))
-        .collect();
-    let encoded = results.into_iter().collect::<anyhow::Result<Vec<anytop::Encoded>>>()?;
-    let (mut features, placements): (Vec<Features>, Vec<Placement>) = encoded.into_iter().map(|e| (e.features, e.placement)).unzip();
-    batch::check_stackable(&names(clips), &features).map_err(anyhow::Error::msg)?;
+    say.info(format_args!("rig: {}", rig.section.rig.describe(&first.skeleton)));
+    let (mut features, placements) = rig.encode(clips)?;
     for (clip, f) in clips.iter().zip(&features) {
         let [n, j, d] = f.shape();
         say.info(format_args!("{}: {} frames, {j} joints -> anytop features [{n}, {j}, {d}]", clip.name, clip.motion.frames));
     }
-
-    // Statistics: of the given clips for --stats; --normalise and the emitted document use the
-    // record's when it has them (so that its --normalised decoding undoes this call's).
-    let record_has_stats = section.stats.is_some();
-    let need_clip_stats = args.stats.is_some() || (!record_has_stats && (args.normalise || args.emit_skeleton.is_some()));
-    let clip_stats = if need_clip_stats { Some(AnyTopStats::compute(features.iter()).context("computing the statistics")?) } else { None };
-    if !record_has_stats {
-        section.stats = clip_stats.clone();
-    }
-    if args.normalise {
-        let stats = section.stats.as_ref().expect("computed above when absent");
-        let source = if record_has_stats { rig_name.clone() } else { "the given clips".to_string() };
-        for f in &mut features {
-            stats.normalise(f).with_context(|| format!("normalising with the statistics of {source}"))?;
-        }
-        say.info(format_args!("normalised with the statistics of {source}"));
+    let stats = rig.statistics(&mut features, args.stats.is_some(), want_stats, args.normalise)?;
+    if let Some(from) = &stats.normalised_with {
+        say.info(format_args!("normalised with the statistics of {from}"));
     }
 
     let mut outputs = vec![(args.common.output.clone(), npy_bytes(clips, &features)?)];
     if let Some(path) = &args.stats {
-        let stats = clip_stats.as_ref().expect("computed for --stats");
+        let stats = stats.clips.as_ref().expect("computed for --stats");
         outputs.push((Some(path.clone()), json_line(stats)?));
     }
     if let Some(path) = &args.placement {
@@ -508,8 +449,8 @@ fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) ->
         outputs.push((Some(path.clone()), json.into_bytes()));
     }
     if let Some(path) = &args.emit_skeleton {
-        document.anytop = Some(section);
-        outputs.push((Some(path.clone()), json_line(&document)?));
+        rig.document.anytop = Some(rig.section);
+        outputs.push((Some(path.clone()), json_line(&rig.document)?));
     }
     output::write_all(&outputs)
 }

@@ -28,9 +28,9 @@
 //! Everything is sequential f64 arithmetic in a fixed order: same input and seed, same labels.
 
 pub mod input;
-pub mod report;
 mod kmeans;
 mod pca;
+pub mod report;
 
 pub use kmeans::{kmeans, KMeans, MAX_ITERATIONS};
 pub use pca::{pca, Pca};
