@@ -1,7 +1,8 @@
 //! The latent model's side of `mo-encode` (`--latent`, `--decode-latent`) and `mo-retarget
 //! --method latent`: files in, files out, around `sata::clips`, which does the work.
 
-use crate::cli::load::{motion_file, read_skeleton, MotionFormat};
+use crate::cli::load::read_skeleton;
+use crate::motion::write::{motion_file, MotionFormat};
 use crate::io::{self, npy};
 use crate::sata::checkpoint::FrozenAutoencoder;
 use crate::sata::clips::{self, SourceClip, Target};
@@ -59,5 +60,5 @@ pub fn decode_file(
     stdout: MotionFormat,
 ) -> anyhow::Result<Vec<u8>> {
     let motion = target.decode(model, latents, frame_time, device)?;
-    motion_file(&target.file.skeleton, &motion, output, stdout)
+    Ok(motion_file(&target.file.skeleton, &motion, output, stdout)?)
 }

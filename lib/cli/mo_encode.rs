@@ -26,6 +26,7 @@ use crate::cli::{output, CommonOpts};
 use crate::document::MotionInfo;
 use crate::io::{self, npy};
 use crate::motion::clip::Clip;
+use crate::motion::write;
 use crate::motion::Motion;
 use crate::repr::anytop::{self, placements, NamedOverrides, Placement};
 use crate::repr::{m2m, Features};
@@ -531,7 +532,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         .enumerate()
         .map(|(i, f)| {
             let motion = decoder.decode(i, f, skeleton).map_err(|e| anyhow!("{}: {e}", label(i)))?;
-            crate::cli::load::motion_file(skeleton, &motion, paths[i].as_deref(), MotionFormat::Bvh)
+            Ok(write::motion_file(skeleton, &motion, paths[i].as_deref(), MotionFormat::Bvh)?)
         })
         .collect();
     let texts = texts.into_iter().collect::<anyhow::Result<Vec<Vec<u8>>>>()?;

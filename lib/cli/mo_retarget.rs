@@ -6,7 +6,8 @@
 use crate::binding::auto;
 use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips};
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips};
+use crate::motion::write::motion_file;
 use crate::cli::output::{self, OutFormat};
 use crate::cli::CommonOpts;
 use crate::io;

@@ -291,7 +291,7 @@ fn write_samples(
             let mut files = Vec::with_capacity(paths.len());
             for (i, (f, path)) in samples.iter().zip(paths).enumerate() {
                 let motion = rig.decode_ik(skeleton, f, placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
-                let bytes = crate::cli::load::motion_file(skeleton, &motion, Some(&path), crate::cli::load::MotionFormat::Bvh)?;
+                let bytes = crate::motion::write::motion_file(skeleton, &motion, Some(&path), crate::cli::load::MotionFormat::Bvh)?;
                 files.push((Some(path), bytes));
             }
             output::write_all(&files)

@@ -77,7 +77,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let files = generated
                 .iter()
                 .zip(paths)
-                .map(|(g, p)| Ok((Some(p.clone()), crate::cli::load::motion_file(skeleton, &g.motion, Some(&p), crate::cli::load::MotionFormat::Bvh)?)))
+                .map(|(g, p)| Ok((Some(p.clone()), crate::motion::write::motion_file(skeleton, &g.motion, Some(&p), crate::cli::load::MotionFormat::Bvh)?)))
                 .collect::<anyhow::Result<Vec<_>>>()?;
             output::write_all(&files)?;
         }

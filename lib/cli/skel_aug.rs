@@ -137,7 +137,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 } else {
                     let skeleton = Skeleton::from_bvh(&edited);
                     let motion = crate::motion::Motion::from_bvh(&edited, &skeleton);
-                    crate::cli::load::motion_file(&skeleton, &motion, out.as_deref(), format)?
+                    crate::motion::write::motion_file(&skeleton, &motion, out.as_deref(), format)?
                 }
             }
             Input::Document(d) => {
