@@ -2,8 +2,8 @@
 //! --method latent`: files in, files out, around `sata::clips`, which does the work.
 
 use crate::cli::load::read_skeleton;
-use crate::motion::write::{motion_file, MotionFormat};
 use crate::io::{self, npy};
+use crate::motion::write::{motion_file, MotionFormat};
 use crate::sata::checkpoint::FrozenAutoencoder;
 use crate::sata::clips::{self, SourceClip, Target};
 use crate::sata::infer::Latents;

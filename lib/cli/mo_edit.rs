@@ -2,7 +2,6 @@
 //! only reads, calls `edit` and writes; the edits themselves live in `lib/edit`.
 
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips};
-use crate::motion::write::{motion_bytes, MotionFormat};
 use crate::cli::mo_metrics::{parse_ground, physics_options, GroundArg};
 use crate::cli::output::OutFormat;
 use crate::cli::{bounds, CommonOpts};
@@ -10,6 +9,7 @@ use crate::edit::space::{Axes, SignedAxis, Units};
 use crate::edit::time::Span;
 use crate::edit::{self, EditError};
 use crate::io::{self, npy};
+use crate::motion::write::{motion_bytes, MotionFormat};
 use crate::motion::Clip;
 use crate::motion::Motion;
 use crate::skeleton::Skeleton;
