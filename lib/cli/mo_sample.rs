@@ -6,6 +6,7 @@ use crate::cli::{output, CommonOpts};
 use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit::{self, KeepMask};
+use crate::diffusion::keep::{Kept, Reference};
 use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
 use crate::diffusion::Sampler;
 use crate::io;
@@ -175,14 +176,6 @@ pub struct Args {
     pub common: CommonOpts,
 }
 
-/// The reference clip of an edit, encoded on the sampled skeleton's rig.
-struct Reference {
-    name: String,
-    /// Physical units, `[bvh frames − 1, joints, 13]`.
-    features: Features,
-    placement: crate::repr::anytop::Placement,
-}
-
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SamplerArg {
     Ddpm,
@@ -331,33 +324,12 @@ fn read_reference(
         e @ crate::motion::ClipError::Skeleton { .. } => anyhow::Error::new(e),
         e => anyhow::Error::new(e).context(format!("the reference {name}")),
     })?;
-    if let Some(diff) = skeleton.first_difference(&clip.skeleton) {
-        bail!("the reference {name} is not on the skeleton of {skeleton_name}: {diff}");
-    }
-    let motion = clip.motion;
-    if motion.frames < 2 {
-        bail!("the reference {name} has {} frame(s); AnyTop features need at least 2", motion.frames);
-    }
-    let encoded = rig.encode(skeleton, &motion).map_err(|e| anyhow::anyhow!("the reference {name}: {e}"))?;
-    Ok(Reference { name, features: encoded.features, placement: encoded.placement })
+    Ok(Reference::encode(clip, skeleton_name, skeleton, rig)?)
 }
 
-/// The cells `--keep-frames` and `--keep-joints` keep: frames must exist in both the output and
-/// the reference; joints are kept over every output frame the reference has.
+/// The cells `--keep-frames` and `--keep-joints` keep (`diffusion::keep`): frames must exist in
+/// both the output and the reference; joints are kept over every output frame the reference has.
 fn keep_mask(args: &Args, r: &Reference, skeleton: &crate::skeleton::Skeleton, frames: usize) -> anyhow::Result<KeepMask> {
-    let mut mask = KeepMask::new(frames, skeleton.len());
-    let known = frames.min(r.features.frames);
-    if let Some(text) = &args.keep_frames {
-        let why = format!("the output has {frames} frames, the reference {} has {} frames of features", r.name, r.features.frames);
-        let ranges = edit::parse_frame_ranges(text, known, &why).context("--keep-frames")?;
-        mask.keep_frames(&ranges);
-    }
-    if let Some(list) = &args.keep_joints {
-        let joints = edit::select_joints(skeleton, list).context("--keep-joints")?;
-        mask.keep_joints(&joints, 0..known);
-    }
-    if mask.count() == mask.keep.len() {
-        bail!("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate");
-    }
-    Ok(mask)
+    let why = format!("the output has {frames} frames, the reference {} has {} frames of features", r.name, r.features.frames);
+    Ok(Kept::resolve(args.keep_frames.as_deref(), args.keep_joints.as_deref(), skeleton, frames, r.features.frames, &why)?.mask())
 }

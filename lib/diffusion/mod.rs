@@ -6,6 +6,7 @@ pub mod condition;
 pub mod data;
 pub mod edit;
 pub mod ema;
+pub mod keep;
 pub mod sample;
 pub mod schedule;
 pub mod train;
