@@ -26,13 +26,14 @@ use crate::cli::{output, CommonOpts};
 use crate::document::MotionInfo;
 use crate::io::{self, npy};
 use crate::motion::clip::Clip;
-use crate::motion::write;
+
+use crate::encode::{self, decode};
+use crate::input;
 use crate::motion::Motion;
 use crate::repr::anytop::{self, placements, NamedOverrides, Placement};
 use crate::repr::{m2m, Features};
 use crate::skeleton::Skeleton;
-use crate::{encode, input};
-use anyhow::{anyhow, bail, Context};
+use anyhow::{bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -494,14 +495,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         Repr::Anytop => {
             let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?.map(|(clip, _)| clip);
             let section = arg.record_with(rest_pose.as_ref(), &overrides(args), args.normalised)?;
-            let stats = match (args.normalised, section.stats) {
-                (false, _) => None,
-                (true, Some(stats)) => Some(stats),
-                (true, None) => bail!(
-                    "--normalised: {} has no AnyTop statistics to undo the normalisation with (give --skeleton the document mo-encode --emit-skeleton wrote for these features)",
-                    arg.name
-                ),
-            };
+            let stats = decode::normalisation(section.stats, args.normalised, &arg.name)?;
             let placements = match args.placement.as_deref() {
                 Some(p) => read_placements(p, samples.len(), &name)?,
                 None => vec![section.rig.rest_placement(); samples.len()],
@@ -512,10 +506,8 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     };
 
     // Check everything before writing anything.
-    let label = |i: usize| if batch { format!("{name}: sample {i}") } else { name.clone() };
-    for (i, f) in samples.iter().enumerate() {
-        decoder.check(f, skeleton).map_err(|(e, hint)| anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name))?;
-    }
+    let batch = decode::Samples { name: &name, batch, features: &samples, skeleton, skeleton_name: &arg.name };
+    batch.check(&decoder)?;
     let target = args.common.output.as_deref();
     let paths: Vec<Option<PathBuf>> = if target.is_none_or(is_dash) {
         if samples.len() > 1 {
@@ -527,15 +519,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         output::numbered(pattern, samples.len())?.into_iter().map(Some).collect()
     };
 
-    let texts: Vec<anyhow::Result<Vec<u8>>> = samples
-        .par_iter()
-        .enumerate()
-        .map(|(i, f)| {
-            let motion = decoder.decode(i, f, skeleton).map_err(|e| anyhow!("{}: {e}", label(i)))?;
-            Ok(write::motion_file(skeleton, &motion, paths[i].as_deref(), MotionFormat::Bvh)?)
-        })
-        .collect();
-    let texts = texts.into_iter().collect::<anyhow::Result<Vec<Vec<u8>>>>()?;
+    let texts = batch.decode_files(&decoder, &paths)?;
     let frames = samples.first().map_or(0, |f| f.frames);
     args.common.say("mo-encode").info(format_args!("{name}: {} sample(s) of {frames} frames decoded on {}", samples.len(), arg.name));
     output::write_all(&paths.into_iter().zip(texts).collect::<Vec<_>>())

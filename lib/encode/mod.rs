@@ -2,10 +2,14 @@
 //! the AnyTop rig (a skeleton file's record, else AnyTop's rest-pose rule over the clips), the
 //! placements the features leave out, the statistics and the normalisation they allow.
 //!
+//! `decode` is the way back: samples decoded on a skeleton as motion files.
+//!
 //! `mo-encode` reads files and writes them; everything between is here, so that a library
 //! caller who encodes clips gets the rig, the features and the statistics the tool would write,
 //! byte for byte. Clips are encoded in parallel (rayon), each sequentially, and collected in
 //! order, so the result does not depend on the number of threads.
+
+pub mod decode;
 
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
 use crate::input::{self, InputError, SkeletonFile};
