@@ -18,8 +18,7 @@ pub fn load_model(dir: Option<&Path>, device: &Device) -> anyhow::Result<FrozenA
 
 /// A motion file read for encoding (an NPY is refused: it holds features, not a clip).
 pub fn read_source(path: &Path, model: &FrozenAutoencoder, device: &Device) -> anyhow::Result<SourceClip> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(path)?;
     if bytes.starts_with(b"\x93NUMPY") {
         bail!("{name}: expected a BVH clip to encode, found an NPY file (decode features first: mo-encode --decode)");
     }
@@ -39,8 +38,7 @@ pub fn read_target(path: &Path, model: &FrozenAutoencoder, device: &Device) -> a
 
 /// Latents `[frames, latent]` from an NPY file.
 pub fn read_latents(path: &Path) -> anyhow::Result<Latents> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(path)?;
     Ok(clips::latents_of(npy::from_bytes(&bytes, &name)?, &name)?)
 }
 

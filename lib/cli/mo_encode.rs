@@ -341,8 +341,7 @@ fn check_stdin(args: &Args) -> anyhow::Result<()> {
 /// Parse a motion file, not validated (`frames`: only the first so many, for rest poses), with
 /// the summary its skeleton document carries.
 fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<(Clip, Option<MotionInfo>)> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(path)?;
     let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
     drop(bytes);
     let skeleton = Skeleton::from_bvh(&parsed);
@@ -484,8 +483,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     let skeleton_path = args.skeleton.as_deref().context("--decode needs --skeleton")?;
     let arg = read_skeleton(skeleton_path)?;
     let skeleton = &arg.skeleton;
-    let name = io::display_name(&input);
-    let bytes = io::read_input(&input).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(&input)?;
     let array = npy::from_bytes(&bytes, &name)?;
     drop(bytes);
     let (samples, batch) = split_samples(array, &name).map_err(anyhow::Error::msg)?;

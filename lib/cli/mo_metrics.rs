@@ -383,8 +383,7 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
 fn run_aggregate(paths: &[PathBuf]) -> anyhow::Result<Value> {
     let mut reports = Vec::new();
     for path in paths {
-        let name = io::display_name(path);
-        let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+        let (name, bytes) = io::read_named(path)?;
         let v: Value = serde_json::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{name}: not JSON: {e}"))?;
         reports.push((name, v));
     }

@@ -12,7 +12,7 @@ use crate::render::html::{render_html, HtmlOptions};
 use crate::render::labels::{self, FrameLabels, JointLabels};
 use crate::render::sheet::{render_sheet, SheetOptions};
 use crate::render::{Legend, Track, View};
-use anyhow::{bail, Context};
+use anyhow::bail;
 use std::path::{Path, PathBuf};
 
 const EXAMPLES: &str = "\
@@ -196,8 +196,7 @@ fn kind_of_extension(p: &Path) -> Option<Kind> {
 }
 
 fn read_text(path: &Path) -> anyhow::Result<String> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(path)?;
     String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))
 }
 

@@ -12,7 +12,7 @@ use crate::dift::DiftOptions;
 use crate::io::{self, npy};
 use crate::segment::input::{dift_features, raw_features, segment_input, window_frames, Input};
 use crate::segment::SegmentOptions;
-use anyhow::{bail, Context};
+use anyhow::bail;
 use std::path::PathBuf;
 
 const EXAMPLES: &str = "\
@@ -173,8 +173,7 @@ fn load(args: &Args) -> anyhow::Result<Input> {
     if is_dash(&args.input) && args.skeleton.as_deref().is_some_and(is_dash) {
         bail!("stdin ('-') can be read only once, but the input and --skeleton both read it");
     }
-    let name = io::display_name(&args.input);
-    let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(&args.input)?;
     let skeleton = match &args.skeleton {
         Some(path) => Some(read_skeleton(path)?),
         None => None,

@@ -85,8 +85,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // Output paths first: a bad pattern fails before any work and before any output.
     let outputs = output_paths(args.common.output.as_deref(), count)?;
 
-    let name = io::display_name(&args.input);
-    let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(&args.input)?;
     let input = Source::parse(&bytes, &name, &args.input, &crate::cli::load::gltf_options())?;
     // Every variant is held until all are written (all or nothing); each has its frames.
     crate::budget::check("the variants' text", count as u128 * (bytes.len() as u128 + 64 * args.add as u128), 2)?;

@@ -65,16 +65,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let rest_pose = match &args.rest_pose {
         Some(path) => {
-            let name = io::display_name(path);
-            let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+            let (name, bytes) = io::read_named(path)?;
             Some(RestPose::of_bvh(&crate::cli::load::parse_motion(&bytes, &name, path)?, &name)?)
         }
         None => None,
     };
     let mut out = String::new();
     for path in &args.inputs {
-        let name = io::display_name(path);
-        let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+        let (name, bytes) = io::read_named(path)?;
         let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
         let (doc, no_record) = SkeletonDocument::of_file(&parsed, &name, args.dmax as usize, !args.no_anytop, rest_pose.as_ref())?;
         if let (Some(e), false) = (no_record, args.common.quiet) {
