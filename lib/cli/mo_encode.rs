@@ -29,9 +29,11 @@ use crate::motion::clip::Clip;
 
 use crate::encode::{self, decode};
 use crate::input;
+use crate::motion::write;
 use crate::motion::Motion;
 use crate::repr::anytop::{self, placements, NamedOverrides, Placement};
 use crate::repr::{m2m, Features};
+use crate::sata;
 use crate::skeleton::Skeleton;
 use anyhow::{bail, Context};
 use rayon::prelude::*;
@@ -263,14 +265,14 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         bail!("stdin ('-') can be read only once");
     }
     let device = candle_core::Device::Cpu;
-    let model = super::latent::load_model(args.model.as_deref(), &device)?;
+    let model = sata::clips::frozen_or_default(args.model.as_deref(), &device)?;
     let bytes = if args.latent {
         let [input] = args.inputs.as_slice() else { bail!("--latent encodes one BVH clip, {} given", args.inputs.len()) };
         let clip = super::latent::read_source(input, &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &clip.name, &clip.skeleton, args.common.quiet)?;
-        let latents = super::latent::encode(&model, &clip, &device)?;
+        let latents = clip.encode(&model, &device)?;
         output::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
-        super::latent::latents_npy(&latents)?
+        sata::clips::latents_npy(&latents).context("building the NPY")?
     } else {
         let input = match args.inputs.as_slice() {
             [] => PathBuf::from("-"),
@@ -279,10 +281,11 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         };
         let latents = super::latent::read_latents(&input)?;
         let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
-        let target = super::latent::read_target(skeleton, &model, &device)?;
+        let target = sata::clips::Target::new(read_skeleton(skeleton)?, &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.file.name, &target.file.skeleton, args.common.quiet)?;
         let frame_time = target.file.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
-        super::latent::decode_file(&model, &latents, &target, frame_time, &device, args.common.output.as_deref(), MotionFormat::Bvh)?
+        let motion = target.decode(&model, &latents, frame_time, &device)?;
+        write::motion_file(&target.file.skeleton, &motion, args.common.output.as_deref(), MotionFormat::Bvh)?
     };
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }

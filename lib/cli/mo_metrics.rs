@@ -275,7 +275,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: bool) -> anyhow::Result<Value> {
     let device = candle_core::Device::Cpu;
     let known = if latent {
-        super::ood::Known::latent(model, &super::latent::load_model(model, &device)?.rigs)?
+        super::ood::Known::latent(model, &crate::sata::clips::frozen_or_default(model, &device)?.rigs)?
     } else {
         super::ood::Known::denoiser(model, &crate::diffusion::checkpoint::frozen_or_default(model, &device)?.info)?
     };

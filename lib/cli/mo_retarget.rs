@@ -6,7 +6,7 @@
 use crate::binding::auto;
 use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips};
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
 use crate::cli::output::{self, OutFormat};
 use crate::cli::CommonOpts;
 use crate::io;
@@ -196,15 +196,16 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     }
     let started = Instant::now();
     let device = candle_core::Device::Cpu;
-    let model = super::latent::load_model(args.model.as_deref(), &device)?;
+    let model = crate::sata::clips::frozen_or_default(args.model.as_deref(), &device)?;
     let source = super::latent::read_source(&args.source, &model, &device)?;
-    let target = super::latent::read_target(&target_path, &model, &device)?;
+    let target = crate::sata::clips::Target::new(read_skeleton(&target_path)?, &model, &device)?;
     let known = super::ood::Known::latent(args.model.as_deref(), &model.rigs)?;
     for (name, skeleton) in [(&source.name, &source.skeleton), (&target.file.name, &target.file.skeleton)] {
         known.warn("mo-retarget", name, skeleton, args.common.quiet)?;
     }
-    let latents = super::latent::encode(&model, &source, &device)?;
-    let bytes = super::latent::decode_file(&model, &latents, &target, source.motion.frame_time, &device, args.common.output.as_deref(), args.format.motion())?;
+    let latents = source.encode(&model, &device)?;
+    let motion = target.decode(&model, &latents, source.motion.frame_time, &device)?;
+    let bytes = motion_file(&target.file.skeleton, &motion, args.common.output.as_deref(), args.format.motion())?;
     if args.report {
         eprintln!(
             "mo-retarget: latent: {} ({} joints) -> {} ({} joints), {} frames, latent {} per frame, {:.2} s",
