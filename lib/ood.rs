@@ -193,6 +193,23 @@ impl Reference {
         Ok(self.score(&Profile::of_skeleton(label, skeleton, NameTable::builtin()?)))
     }
 
+    /// The report `mo-metrics ood` prints: each skeleton's score against this reference (the
+    /// training skeletons of `model`), the limit, and with `training` each training skeleton's
+    /// nearest other one.
+    pub fn report(&self, model: &str, skeletons: &[(String, Skeleton)], training: bool) -> Result<serde_json::Value, EmbedError> {
+        use serde_json::{json, Value};
+        let mut scored = Vec::new();
+        for (name, skeleton) in skeletons {
+            scored.push(json!({ "skeleton": name, "ood": self.score_skeleton(name, skeleton)? }));
+        }
+        let mut report = json!({ "model": model, "limit": LIMIT, "skeletons": scored });
+        if training {
+            let within: Vec<Value> = self.nearest_within().into_iter().map(|(a, b, d)| json!({ "skeleton": a, "nearest": b, "distance": d })).collect();
+            report["training"] = Value::Array(within);
+        }
+        Ok(report)
+    }
+
     /// Each training skeleton with the other one it is closest to, and their distance.
     pub fn nearest_within(&self) -> Vec<(String, String, f64)> {
         (0..self.profiles.len())

@@ -14,7 +14,7 @@ use crate::metrics::physics::{Ground, PhysicsOptions};
 use crate::metrics::{checks, report};
 use crate::motion::Clip;
 use anyhow::{bail, Context};
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 const EXAMPLES: &str = "\
@@ -282,17 +282,8 @@ fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: boo
     if known.reference.profiles.is_empty() {
         bail!("{} records no training skeletons to compare with", known.model);
     }
-    let mut scored = Vec::new();
-    for path in skeletons {
-        let arg = read_skeleton(path)?;
-        scored.push(json!({ "skeleton": arg.name, "ood": known.score(&arg.name, &arg.skeleton)? }));
-    }
-    let mut report = json!({ "model": known.model, "limit": crate::ood::LIMIT, "skeletons": scored });
-    if args.common.verbose {
-        let within: Vec<Value> = known.reference.nearest_within().into_iter().map(|(a, b, d)| json!({ "skeleton": a, "nearest": b, "distance": d })).collect();
-        report["training"] = Value::Array(within);
-    }
-    Ok(report)
+    let skeletons = skeletons.iter().map(|p| read_skeleton(p).map(|f| (f.name, f.skeleton))).collect::<Result<Vec<_>, _>>()?;
+    Ok(known.reference.report(&known.model, &skeletons, args.common.verbose)?)
 }
 
 pub fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -> anyhow::Result<PhysicsOptions> {
