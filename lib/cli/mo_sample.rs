@@ -11,7 +11,6 @@ use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
 use crate::diffusion::Sampler;
 use crate::io;
 use crate::repr::anytop::{AnyTopRig, IkOptions, Placement};
-use crate::repr::smooth::lambda_for_cutoff;
 use crate::repr::Features;
 use anyhow::{bail, Context};
 use candle_core::Device;
@@ -241,11 +240,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         eprintln!("mo-sample: {}: not a trained skeleton and no statistics in it: normalising by its rest pose and the trained skeletons' spreads", arg.name);
     }
     let cond = condition.condition();
-    let lambda = smoothing(args.smooth, fps)?;
-    if !(args.blend.is_finite() && args.blend >= 0.0 && args.blend <= crate::cli::bounds::MAX_SECONDS) {
-        bail!("--blend must be a duration in seconds (>= 0), found {}", args.blend);
-    }
-    let blend = (args.blend * fps).round() as usize;
+    let post = PostProcess::new(args.smooth, args.blend, !args.no_plant_feet, fps, crate::cli::bounds::MAX_SECONDS)?;
     let schedule = loaded.info.schedule();
     let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler: args.sampler.sampler(), seed: args.common.seed };
     let started = std::time::Instant::now();
@@ -254,7 +249,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
     };
     let fixed = mask.as_ref().map(|m| m.keep.as_slice());
-    let post = PostProcess { smooth: lambda, blend, plant_feet: !args.no_plant_feet };
     for f in &mut samples {
         post.apply(f, &section.rig.feet, fixed);
     }
@@ -293,20 +287,6 @@ fn write_samples(
             output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
             Ok(io::write_output(args.common.output.as_deref(), &output::features_npy(samples, true)?)?)
         }
-    }
-}
-
-/// The smoother's weight for `--smooth HZ` at `fps`; `None` for 0 (raw output).
-fn smoothing(hz: f64, fps: f64) -> anyhow::Result<Option<f64>> {
-    if hz == 0.0 {
-        return Ok(None);
-    }
-    if !hz.is_finite() || hz < 0.0 {
-        bail!("--smooth must be a cutoff in Hz (>= 0; 0 = no smoothing), found {hz}");
-    }
-    match lambda_for_cutoff(hz, fps) {
-        Some(lambda) => Ok(Some(lambda)),
-        None => bail!("--smooth {hz}: the cutoff must be below half the frame rate ({:.1} Hz at {fps:.1} fps); 0 = no smoothing", fps / 2.0),
     }
 }
 
