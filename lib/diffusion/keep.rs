@@ -90,3 +90,29 @@ impl Reference {
         Ok(Reference { name, features: encoded.features, placement: encoded.placement })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kept_frames_and_joints_make_the_mask_and_everything_is_refused() {
+        let (skeleton, _) = crate::synth::creature("quadruped", 0).unwrap();
+        let joints = skeleton.len();
+        let kept = Kept::resolve(Some("0-1"), None, &skeleton, 4, 10, "").unwrap();
+        assert_eq!(kept.frames, vec![true, true, false, false]);
+        let mask = kept.mask();
+        assert_eq!(mask.count(), 2 * joints);
+        assert_eq!(mask.whole_frames(), vec![true, true, false, false]);
+        // Joints are kept over the frames the reference has, and only those.
+        let root = skeleton.joints[0].name.clone();
+        let kept = Kept::resolve(None, Some(&root), &skeleton, 4, 2, "").unwrap();
+        assert_eq!(kept.mask().count(), 2);
+        assert!(matches!(Kept::resolve(Some("0-3"), None, &skeleton, 4, 10, ""), Err(EditError::KeepsAll)));
+        let every = format!("{root}/");
+        assert!(matches!(Kept::resolve(None, Some(&every), &skeleton, 4, 10, ""), Err(EditError::KeepsAll)));
+        // A range past the reference names the option.
+        let e = Kept::resolve(Some("0-5"), None, &skeleton, 8, 4, "why").unwrap_err();
+        assert!(e.to_string().starts_with("--keep-frames"), "{e}");
+    }
+}

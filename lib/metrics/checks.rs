@@ -80,3 +80,25 @@ pub fn generation_rig(first: &Clip) -> Result<AnyTopSection, ReportError> {
     AnyTopSection::new(&first.skeleton, &first.motion.first_frames(2), &RigOptions::default())
         .map_err(|source| ReportError::Rig { name: first.name.clone(), source })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn clip(name: &str, frames: usize) -> Clip {
+        let (skeleton, motion) = crate::synth::creature("quadruped", 0).unwrap();
+        Clip { name: name.into(), motion: motion.first_frames(frames), skeleton }
+    }
+
+    #[test]
+    fn a_round_trip_one_frame_short_is_compared_on_its_frames() {
+        let (mut a, b) = (clip("a", 10), clip("b", 9));
+        let note = reconstruction_pair(&mut a, &b).unwrap();
+        assert!(note.is_some_and(|n| n.contains("one frame fewer")));
+        assert_eq!(a.motion.frames, 9);
+        let (mut a, b) = (clip("a", 10), clip("b", 7));
+        assert!(reconstruction_pair(&mut a, &b).unwrap_err().to_string().contains("frame by frame"));
+        assert!(one_skeleton(&[clip("a", 3)], &[clip("b", 4)]).is_ok());
+        assert!(some_pairs(&clip("a", 2), &clip("b", 2), &[]).is_err());
+    }
+}
