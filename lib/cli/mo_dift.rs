@@ -5,7 +5,7 @@ use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{output, CommonOpts};
 use crate::diffusion::checkpoint::{self, FrozenDenoiser};
 use crate::dift::{self, report, DiftFeatures, DiftOptions};
-use crate::io::{self, npy};
+use crate::io;
 use crate::motion::Clip;
 use anyhow::{bail, Context};
 use candle_core::Device;
@@ -168,9 +168,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let bytes = if !pairwise {
         let f = &features[0];
         output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout or give -o FILE")?;
-        let mut bytes = Vec::new();
-        npy::write_f32_parts(&mut bytes, &[f.tokens, f.joints, f.width], &[f.data.as_slice()]).context("building the NPY")?;
-        bytes
+        f.to_npy().context("building the NPY")?
     } else {
         comparison(args, &motions, &features, &opts)?.into_bytes()
     };

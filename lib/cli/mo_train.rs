@@ -321,11 +321,10 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
 
 /// `--arch sata`: a new or resumed latent autoencoder; returns the steps done.
 fn train_sata(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Result<u64> {
-    let mut config = args.preset.sata();
-    if let Some(crop) = args.crop {
-        config.window = crop as usize;
-        config.overlap = config.overlap.min(config.window.saturating_sub(1) / 2);
-    }
+    let config = match args.crop {
+        Some(crop) => args.preset.sata().with_window(crop as usize),
+        None => args.preset.sata(),
+    };
     let opts = SataOptions {
         config,
         seed: args.common.seed,
