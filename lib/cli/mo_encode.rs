@@ -30,11 +30,9 @@ use crate::motion::clip::Clip;
 use crate::encode::{self, decode};
 use crate::input;
 use crate::motion::write;
-use crate::motion::Motion;
 use crate::repr::anytop::{self, placements, NamedOverrides, Placement};
 use crate::repr::{m2m, Features};
 use crate::sata;
-use crate::skeleton::Skeleton;
 use anyhow::{bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -341,16 +339,9 @@ fn check_stdin(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Parse a motion file, not validated (`frames`: only the first so many, for rest poses), with
-/// the summary its skeleton document carries.
+/// `encode::read_clip` with this run's glTF options.
 fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<(Clip, Option<MotionInfo>)> {
-    let (name, bytes) = io::read_named(path)?;
-    let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
-    drop(bytes);
-    let skeleton = Skeleton::from_bvh(&parsed);
-    let motion = Motion::from_bvh_frames(&parsed, &skeleton, 0..frames.unwrap_or(usize::MAX));
-    let info = MotionInfo::of(&parsed, &skeleton);
-    Ok((Clip { name, skeleton, motion }, info))
+    Ok(encode::read_clip(path, frames, &crate::cli::load::gltf_options())?)
 }
 
 fn encode(args: &Args) -> anyhow::Result<()> {

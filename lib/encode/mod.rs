@@ -12,12 +12,16 @@
 pub mod decode;
 
 use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
+use crate::gltf::ReadOptions;
 use crate::input::{self, InputError, SkeletonFile};
+use crate::io;
 use crate::motion::clip::{self, Clip, RestChoice};
+use crate::motion::Motion;
 use crate::repr::anytop::{AnyTopError, AnyTopStats, NamedOverrides, Placement, RestSource};
 use crate::repr::{batch, m2m, Features};
-use crate::skeleton::topology;
+use crate::skeleton::{topology, Skeleton};
 use rayon::prelude::*;
+use std::path::Path;
 
 /// Why clips could not be encoded; every message names the clip or the rig.
 #[derive(Debug, thiserror::Error)]
@@ -28,6 +32,10 @@ pub enum EncodeError {
     TooShort { name: String, frames: usize },
     #[error(transparent)]
     Input(#[from] InputError),
+    #[error(transparent)]
+    Read(#[from] io::ReadError),
+    #[error(transparent)]
+    Clip(#[from] clip::ClipError),
     #[error("{name}: cannot build an AnyTop rig")]
     Rig {
         name: String,
@@ -52,6 +60,18 @@ pub enum EncodeError {
     /// Clips that cannot share one batch, bad rig overrides, non-finite features.
     #[error("{0}")]
     Invalid(String),
+}
+
+/// A motion file to encode, parsed but not validated (`frames`: only the first so many, for a
+/// rest pose; glTF read with `options`), with the summary its skeleton document carries.
+pub fn read_clip(path: &Path, frames: Option<usize>, options: &ReadOptions) -> Result<(Clip, Option<MotionInfo>), EncodeError> {
+    let (name, bytes) = io::read_named(path)?;
+    let parsed = clip::parse_motion(&bytes, &name, path, options)?;
+    drop(bytes);
+    let skeleton = Skeleton::from_bvh(&parsed);
+    let motion = Motion::from_bvh_frames(&parsed, &skeleton, 0..frames.unwrap_or(usize::MAX));
+    let info = MotionInfo::of(&parsed, &skeleton);
+    Ok((Clip { name, skeleton, motion }, info))
 }
 
 /// Every clip at least two frames long, as AnyTop features need.
