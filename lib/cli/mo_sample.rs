@@ -40,6 +40,14 @@ pub const DEFAULT_SMOOTH_HZ: f64 = 7.0;
 /// Frames per sample (`--frames`, `--seconds`): the denoiser attends over all frames at once.
 pub const MAX_SAMPLE_FRAMES: u64 = 10_000;
 
+/// `--seconds S` as frames at `fps`, at most `MAX_SAMPLE_FRAMES` (both ways of sampling).
+pub fn sample_frames(seconds: f64, fps: f64) -> anyhow::Result<usize> {
+    match crate::cli::bounds::frames_for_seconds(seconds, fps).map_err(anyhow::Error::msg)? {
+        n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {seconds} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
+        n => Ok(n),
+    }
+}
+
 /// The default `--blend`: half a second (15 frames at 30 fps), the order of a step.
 pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 
@@ -219,10 +227,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => None,
     };
     let frames = match args.seconds {
-        Some(s) => match crate::cli::bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
-            n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
-            n => n,
-        },
+        Some(s) => sample_frames(s, fps)?,
         None => match (args.frames, &reference) {
             (Some(n), _) => n as usize,
             (None, Some(r)) => r.features.frames,

@@ -3,9 +3,9 @@
 //! `genmm::Settings` and a `genmm::Keep`, runs `genmm::generate` (one seed per sample), and
 //! writes BVH on the examples' skeleton or Motion2Motion features, all outputs or none.
 
-use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
+use super::mo_sample::{sample_frames, Args};
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
-use crate::cli::{bounds, output};
+use crate::cli::output;
 use crate::diffusion::keep::Kept;
 use crate::genmm::{self, Keep, Settings};
 use crate::io;
@@ -39,10 +39,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let fps = if frame_time > 0.0 { 1.0 / frame_time } else { 30.0 };
     let reference = args.reference.as_deref().map(|path| read_reference(path, first)).transpose()?;
     let frames = match (args.seconds, args.frames, &reference) {
-        (Some(s), _, _) => match bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
-            n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
-            n => n,
-        },
+        (Some(s), _, _) => sample_frames(s, fps)?,
         (None, Some(n), _) => n as usize,
         (None, None, Some(r)) => r.motion.frames,
         (None, None, None) => clips.iter().map(|c| c.motion.frames).max().unwrap_or(1),
