@@ -20,6 +20,7 @@
 //! Skeleton descriptions and edits:
 //! * [`document`]: the skeleton document (JSON) `skel-info` prints and the tools read.
 //! * [`input`]: what tools are given, read: skeleton files, motion files, NPY features on a skeleton.
+//! * [`encode`]: clips of one skeleton as one feature batch, with the rig, placements and statistics.
 //! * [`embed`]: joint-name text embeddings, offline (a built-in MiniLM table).
 //! * [`binding`]: bone bindings between two skeletons, from a file or automatic.
 //! * [`ood`]: how far a skeleton lies from a model's training skeletons (the OOD warning).
@@ -55,6 +56,7 @@ pub mod dift;
 pub mod document;
 pub mod edit;
 pub mod embed;
+pub mod encode;
 pub mod genmm;
 pub mod gltf;
 pub mod input;

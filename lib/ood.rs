@@ -16,7 +16,7 @@
 //! which is named as the nearest. `LIMIT` is calibrated on measurements (docs/ood.md): held-out
 //! zoo skeletons fall inside it, the real captures the built-in model fails on fall outside.
 
-use crate::embed::{cosine, NameTable};
+use crate::embed::{cosine, EmbedError, NameTable};
 use crate::skeleton::Skeleton;
 use glam::DVec3;
 use serde::Serialize;
@@ -159,6 +159,9 @@ pub struct Score {
     pub parts: Distance,
 }
 
+/// Name, joint names, parents and rest offsets of one recorded training skeleton.
+pub type Recorded<'a> = (&'a str, &'a [String], &'a [Option<usize>], &'a [[f64; 3]]);
+
 /// The training skeletons of a model, profiled once.
 pub struct Reference {
     pub profiles: Vec<Profile>,
@@ -169,6 +172,42 @@ impl Reference {
     pub fn score(&self, p: &Profile) -> Option<Score> {
         let (nearest, parts) = self.profiles.iter().map(|t| (t, distance(p, t))).min_by(|x, y| x.1.total.total_cmp(&y.1.total))?;
         Some(Score { score: parts.total, limit: LIMIT, in_range: parts.total <= LIMIT, nearest: nearest.name.clone(), parts })
+    }
+
+    /// The training skeletons as a model records them (name, joint names, parents, rest
+    /// offsets), profiled with the built-in name table; a record whose offsets do not match its
+    /// joints is left out.
+    pub fn from_records<'a>(records: impl Iterator<Item = Recorded<'a>>) -> Result<Reference, EmbedError> {
+        let table = NameTable::builtin()?;
+        let profiles = records
+            .filter(|(_, joints, _, offsets)| offsets.len() == joints.len())
+            .map(|(name, joints, parents, offsets)| {
+                Profile::new(name, joints, parents, &offsets.iter().map(|o| DVec3::from_array(*o)).collect::<Vec<_>>(), table)
+            })
+            .collect();
+        Ok(Reference { profiles })
+    }
+
+    /// `skeleton`'s score (named `label`; None when the model records no skeletons).
+    pub fn score_skeleton(&self, label: &str, skeleton: &Skeleton) -> Result<Option<Score>, EmbedError> {
+        Ok(self.score(&Profile::of_skeleton(label, skeleton, NameTable::builtin()?)))
+    }
+
+    /// The report `mo-metrics ood` prints: each skeleton's score against this reference (the
+    /// training skeletons of `model`), the limit, and with `training` each training skeleton's
+    /// nearest other one.
+    pub fn report(&self, model: &str, skeletons: &[(String, Skeleton)], training: bool) -> Result<serde_json::Value, EmbedError> {
+        use serde_json::{json, Value};
+        let mut scored = Vec::new();
+        for (name, skeleton) in skeletons {
+            scored.push(json!({ "skeleton": name, "ood": self.score_skeleton(name, skeleton)? }));
+        }
+        let mut report = json!({ "model": model, "limit": LIMIT, "skeletons": scored });
+        if training {
+            let within: Vec<Value> = self.nearest_within().into_iter().map(|(a, b, d)| json!({ "skeleton": a, "nearest": b, "distance": d })).collect();
+            report["training"] = Value::Array(within);
+        }
+        Ok(report)
     }
 
     /// Each training skeleton with the other one it is closest to, and their distance.

@@ -15,6 +15,7 @@
 
 pub mod edit;
 pub mod remove;
+pub mod source;
 pub mod subdivide;
 
 pub use edit::{Edit, EditError};

@@ -15,6 +15,7 @@ use std::sync::Mutex;
 
 pub use crate::input::{expand_inputs, is_dash};
 pub use crate::motion::clip::is_gltf;
+pub use crate::motion::write::MotionFormat;
 pub use crate::repr::batch::{split_samples, FeatureDecoder};
 
 /// The glTF input options of this run (`--animation`, `--fps`), set once from `CommonOpts`.
@@ -48,54 +49,6 @@ pub fn read_clip(path: &Path) -> anyhow::Result<Clip> {
 /// A clip from the bytes of a motion file already read (to look at them first).
 pub fn clip_from_bytes(bytes: &[u8], name: &str, path: &Path) -> Result<Clip, clip::ClipError> {
     Clip::from_bytes(bytes, name, path, &gltf_options())
-}
-
-/// The motion file formats tools write.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MotionFormat {
-    Bvh,
-    /// Binary glTF: skin, animation and a stick mesh in one file (Blender, three.js, game engines).
-    Glb,
-    /// glTF JSON with the binary data inlined.
-    Gltf,
-}
-
-impl MotionFormat {
-    /// What a path's extension asks for (`.glb`, `.gltf`; anything else is BVH).
-    pub fn of_path(path: &Path) -> MotionFormat {
-        match path.extension().and_then(|x| x.to_str()).map(str::to_ascii_lowercase).as_deref() {
-            Some("glb") => MotionFormat::Glb,
-            Some("gltf") => MotionFormat::Gltf,
-            _ => MotionFormat::Bvh,
-        }
-    }
-
-    /// The format for an output: the path's extension, or `stdout` for stdout (`None` or `-`).
-    pub fn for_output(path: Option<&Path>, stdout: MotionFormat) -> MotionFormat {
-        match path {
-            Some(p) if !is_dash(p) => MotionFormat::of_path(p),
-            _ => stdout,
-        }
-    }
-}
-
-/// The bytes of a motion file in `format`; `name` is the output's, for messages.
-pub fn motion_bytes(skeleton: &Skeleton, motion: &Motion, format: MotionFormat, name: &str) -> anyhow::Result<Vec<u8>> {
-    Ok(match format {
-        MotionFormat::Bvh => bvh::write_string(&motion.to_bvh(skeleton)).into_bytes(),
-        MotionFormat::Glb => gltf::write_glb(skeleton, motion, name)?,
-        MotionFormat::Gltf => gltf::write_gltf(skeleton, motion, name)?,
-    })
-}
-
-/// A motion written to `path` (or stdout as `stdout` says), in the format the path asks for.
-pub fn motion_file(skeleton: &Skeleton, motion: &Motion, path: Option<&Path>, stdout: MotionFormat) -> anyhow::Result<Vec<u8>> {
-    let name = path.filter(|p| !is_dash(p)).map_or_else(|| "<stdout>".to_string(), |p| p.display().to_string());
-    let format = MotionFormat::for_output(path, stdout);
-    if format == MotionFormat::Glb {
-        crate::io::refuse_terminal(path, "binary glTF", "give -o FILE.glb or redirect stdout")?;
-    }
-    motion_bytes(skeleton, motion, format, &name)
 }
 
 /// Where AnyTop decoding takes the rotations from.

@@ -1,14 +1,11 @@
 //! `mo-dift`: diffusion features of a motion, and joint and frame correspondence from them.
 
-use crate::binding::{auto, clips};
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{output, CommonOpts};
-use crate::correspond as correspondence;
 use crate::diffusion::checkpoint::{self, FrozenDenoiser};
-use crate::dift::correspond::{best_matches, binding_choices, cosine_matrix, monotonic_matches, Match};
-use crate::dift::{self, DiftFeatures, DiftOptions};
-use crate::io::{self, npy};
+use crate::dift::{self, report, DiftFeatures, DiftOptions};
+use crate::io;
 use crate::motion::Clip;
 use anyhow::{bail, Context};
 use candle_core::Device;
@@ -123,6 +120,15 @@ pub enum Align {
     Nearest,
 }
 
+impl From<Align> for report::Align {
+    fn from(align: Align) -> report::Align {
+        match align {
+            Align::Monotonic => report::Align::Monotonic,
+            Align::Nearest => report::Align::Nearest,
+        }
+    }
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     let pairwise = args.joints || args.frames;
@@ -162,9 +168,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let bytes = if !pairwise {
         let f = &features[0];
         output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout or give -o FILE")?;
-        let mut bytes = Vec::new();
-        npy::write_f32_parts(&mut bytes, &[f.tokens, f.joints, f.width], &[f.data.as_slice()]).context("building the NPY")?;
-        bytes
+        f.to_npy().context("building the NPY")?
     } else {
         comparison(args, &motions, &features, &opts)?.into_bytes()
     };
@@ -173,44 +177,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 /// `--joints` or `--frames` with DIFT: the matches of the target's joints or frames to the
 /// reference's, as JSON (or, with `--as-binding`, a binding).
+/// `--joints` or `--frames` with DIFT: the matches of the target's joints or frames to the
+/// reference's, as JSON (or, with `--as-binding`, a binding).
 fn comparison(args: &Args, motions: &[Clip], features: &[DiftFeatures], opts: &DiftOptions) -> anyhow::Result<String> {
     let (reference, target) = (&motions[0], &motions[1]);
-    let mut header = serde_json::json!({
-        "reference": reference.name, "target": target.name, "t": opts.t, "layer": opts.layer, "draws": opts.draws,
-        "model": args.model.as_ref().map_or_else(|| "built-in".to_string(), |p| p.display().to_string()),
-    });
-    let text = if args.joints {
-        let sim = cosine_matrix(&dift::centred(features[1].per_joint()), &dift::centred(features[0].per_joint()));
-        if args.as_binding {
-            let rate = args.bind_rate.unwrap_or(DIFT_BIND_RATE);
-            let choices = binding_choices(&sim, &reference.skeleton, &target.skeleton, rate, auto::AutoOptions::default().min_pairs);
-            if choices.is_empty() {
-                bail!("{} and {}: no joint pair is each other's best match among the joints that move a bone; nothing to bind", reference.name, target.name);
-            }
-            auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
-        } else {
-            let rows = best_matches(&sim).iter().map(|m| joint_row(m, reference, target)).collect::<Vec<_>>();
-            pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
-        }
-    } else {
-        let same = same_skeleton(&reference.skeleton, &target.skeleton);
-        header["align"] = serde_json::json!(if args.align == Align::Monotonic { "monotonic" } else { "nearest" });
-        header["descriptors"] = serde_json::json!(if same { "joints side by side" } else { "mean over joints" });
-        let (r, t) = dift::frame_descriptors(&features[0], &features[1], same);
-        let sim = cosine_matrix(&t, &r);
-        let matches = match args.align {
-            Align::Monotonic => monotonic_matches(&sim),
-            Align::Nearest => best_matches(&sim),
-        };
-        let rows: Vec<_> =
-            matches.iter().map(|m| FrameRow { target: m.target, reference: m.reference, score: round(m.score), margin: round(m.margin) }).collect();
-        pretty(serde_json::json!({ "correspondence": "frames", "settings": header, "matches": rows }))
-    };
-    Ok(text)
+    let features = [&features[0], &features[1]];
+    let model = args.model.as_ref().map_or_else(|| "built-in".to_string(), |p| p.display().to_string());
+    let settings = report::settings(reference, target, opts, &model);
+    Ok(match (args.joints, args.as_binding) {
+        (true, true) => report::joint_binding(reference, target, features, args.bind_rate.unwrap_or(report::DIFT_BIND_RATE))?,
+        (true, false) => report::joint_matches(reference, target, features, settings),
+        (false, _) => report::frame_matches(reference, target, features, settings, args.align.into()),
+    })
 }
-
-/// The paper's binding rate, what `--features dift-only --as-binding` binds by default.
-const DIFT_BIND_RATE: f64 = 0.061;
 
 /// `--joints` with the correspondence engine: no model, the same scores `--bind auto` uses.
 fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
@@ -219,30 +198,8 @@ fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
         bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
     }
     let (reference, target) = (&motions[0], &motions[1]);
-    let text = if args.as_binding {
-        let choices = clips::bind_auto(reference, target, args.bind_rate)?;
-        auto::to_binding(&choices, &reference.skeleton, &reference.name, &target.skeleton, &target.name).to_json()
-    } else {
-        let scores = clips::joint_scores(reference, target)?;
-        let pairs = correspondence::assign(&scores);
-        let rows: Vec<JointRow> = correspondence::per_target(&scores, &pairs)
-            .into_iter()
-            .filter_map(|(_, found)| found)
-            .map(|(p, one_to_one)| {
-                let m = Match { target: p.target, reference: p.source, score: p.score, margin: p.margin };
-                JointRow { confidence: Some(round(p.confidence)), one_to_one: Some(one_to_one), ..joint_row(&m, reference, target) }
-            })
-            .collect();
-        let header = serde_json::json!({ "reference": reference.name, "target": target.name, "features": "combined" });
-        pretty(serde_json::json!({ "correspondence": "joints", "settings": header, "matches": rows }))
-    };
+    let text = if args.as_binding { report::combined_binding(reference, target, args.bind_rate)? } else { report::combined_joint_matches(reference, target)? };
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
-}
-
-/// One skeleton in two files: the same joints (names and parents) in the same order; bone
-/// lengths may differ.
-fn same_skeleton(a: &crate::skeleton::Skeleton, b: &crate::skeleton::Skeleton) -> bool {
-    a.len() == b.len() && a.joints.iter().zip(&b.joints).all(|(x, y)| x.name == y.name && x.parent == y.parent)
 }
 
 /// DIFT features of one loaded motion.
@@ -250,53 +207,4 @@ fn features_of(model: &FrozenDenoiser, m: &Clip, opts: &DiftOptions, device: &De
     let prepared = dift::prepare(&model.info, &m.skeleton, &m.motion, &m.name)?;
     let schedule = model.info.schedule();
     dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, device).with_context(|| m.name.clone())
-}
-
-/// One target joint's answer (a struct, so the fields print in this order).
-#[derive(serde::Serialize)]
-struct JointRow {
-    target: String,
-    target_index: usize,
-    reference: String,
-    reference_index: usize,
-    score: f64,
-    margin: f64,
-    /// The engine's confidence and whether the pair is one to one (absent with dift-only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    confidence: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    one_to_one: Option<bool>,
-}
-
-fn joint_row(m: &Match, reference: &Clip, target: &Clip) -> JointRow {
-    JointRow {
-        target: target.skeleton.joints[m.target].name.clone(),
-        target_index: m.target,
-        reference: reference.skeleton.joints[m.reference].name.clone(),
-        reference_index: m.reference,
-        score: round(m.score),
-        margin: round(m.margin),
-        confidence: None,
-        one_to_one: None,
-    }
-}
-
-/// One target frame's answer.
-#[derive(serde::Serialize)]
-struct FrameRow {
-    target: usize,
-    reference: usize,
-    score: f64,
-    margin: f64,
-}
-
-/// Four decimals: scores are cosines; more digits are noise to a reader.
-fn round(v: f64) -> f64 {
-    (v * 1e4).round() / 1e4
-}
-
-fn pretty(v: serde_json::Value) -> String {
-    let mut s = serde_json::to_string_pretty(&v).unwrap_or_else(|_| v.to_string());
-    s.push('\n');
-    s
 }

@@ -1,7 +1,7 @@
 //! `mo-edit`: the everyday edits of a clip, one subcommand each, composable in pipes. This file
 //! only reads, calls `edit` and writes; the edits themselves live in `lib/edit`.
 
-use crate::cli::load::{is_dash, motion_bytes, read_bvh_clip, read_example_clips, MotionFormat};
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips};
 use crate::cli::mo_metrics::{parse_ground, physics_options, GroundArg};
 use crate::cli::output::OutFormat;
 use crate::cli::{bounds, CommonOpts};
@@ -9,6 +9,7 @@ use crate::edit::space::{Axes, SignedAxis, Units};
 use crate::edit::time::Span;
 use crate::edit::{self, EditError};
 use crate::io::{self, npy};
+use crate::motion::write::{motion_bytes, MotionFormat};
 use crate::motion::Clip;
 use crate::motion::Motion;
 use crate::skeleton::Skeleton;

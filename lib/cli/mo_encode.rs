@@ -23,15 +23,17 @@
 use crate::cli::load::{is_dash, read_skeleton, split_samples, FeatureDecoder};
 pub use crate::cli::load::{load_skeleton, DecodeFrom, MotionFormat};
 use crate::cli::{output, CommonOpts};
-use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
-use crate::input;
+use crate::document::MotionInfo;
 use crate::io::{self, npy};
-use crate::motion::clip::{self, Clip, RestChoice};
-use crate::motion::Motion;
-use crate::repr::anytop::{self, placements, AnyTopStats, NamedOverrides, Placement, RestSource};
-use crate::repr::{batch, m2m, Features};
-use crate::skeleton::{topology, Skeleton};
-use anyhow::{anyhow, bail, Context};
+use crate::motion::clip::Clip;
+
+use crate::encode::{self, decode};
+use crate::input;
+use crate::motion::write;
+use crate::repr::anytop::{self, placements, NamedOverrides, Placement};
+use crate::repr::{m2m, Features};
+use crate::sata;
+use anyhow::{bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -261,14 +263,14 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         bail!("stdin ('-') can be read only once");
     }
     let device = candle_core::Device::Cpu;
-    let model = super::latent::load_model(args.model.as_deref(), &device)?;
+    let model = sata::clips::frozen_or_default(args.model.as_deref(), &device)?;
     let bytes = if args.latent {
         let [input] = args.inputs.as_slice() else { bail!("--latent encodes one BVH clip, {} given", args.inputs.len()) };
         let clip = super::latent::read_source(input, &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &clip.name, &clip.skeleton, args.common.quiet)?;
-        let latents = super::latent::encode(&model, &clip, &device)?;
+        let latents = clip.encode(&model, &device)?;
         output::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
-        super::latent::latents_npy(&latents)?
+        sata::clips::latents_npy(&latents).context("building the NPY")?
     } else {
         let input = match args.inputs.as_slice() {
             [] => PathBuf::from("-"),
@@ -277,10 +279,11 @@ fn latent(args: &Args) -> anyhow::Result<()> {
         };
         let latents = super::latent::read_latents(&input)?;
         let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
-        let target = super::latent::read_target(skeleton, &model, &device)?;
+        let target = sata::clips::Target::new(read_skeleton(skeleton)?, &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.file.name, &target.file.skeleton, args.common.quiet)?;
         let frame_time = target.file.motion.as_ref().map_or(1.0 / 30.0, |m| m.frame_time);
-        super::latent::decode_file(&model, &latents, &target, frame_time, &device, args.common.output.as_deref(), MotionFormat::Bvh)?
+        let motion = target.decode(&model, &latents, frame_time, &device)?;
+        write::motion_file(&target.file.skeleton, &motion, args.common.output.as_deref(), MotionFormat::Bvh)?
     };
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
@@ -336,17 +339,9 @@ fn check_stdin(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Parse a motion file, not validated (`frames`: only the first so many, for rest poses), with
-/// the summary its skeleton document carries.
+/// `encode::read_clip` with this run's glTF options.
 fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<(Clip, Option<MotionInfo>)> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-    let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
-    drop(bytes);
-    let skeleton = Skeleton::from_bvh(&parsed);
-    let motion = Motion::from_bvh_frames(&parsed, &skeleton, 0..frames.unwrap_or(usize::MAX));
-    let info = MotionInfo::of(&parsed, &skeleton);
-    Ok((Clip { name, skeleton, motion }, info))
+    Ok(encode::read_clip(path, frames, &crate::cli::load::gltf_options())?)
 }
 
 fn encode(args: &Args) -> anyhow::Result<()> {
@@ -364,14 +359,9 @@ fn encode(args: &Args) -> anyhow::Result<()> {
     }
 }
 
-/// The names of clips, for batch messages.
-fn names(clips: &[Clip]) -> Vec<&str> {
-    clips.iter().map(|c| c.name.as_str()).collect()
-}
-
 /// One NPY of the clips' features, checked finite first.
 fn npy_bytes(clips: &[Clip], features: &[Features]) -> anyhow::Result<Vec<u8>> {
-    batch::check_finite(&names(clips), clips.iter().map(|c| &c.skeleton), features).map_err(anyhow::Error::msg)?;
+    encode::check_finite(clips, features)?;
     output::features_npy(features, false)
 }
 
@@ -397,9 +387,7 @@ fn check_outputs(args: &Args) -> anyhow::Result<()> {
 
 fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
     let say = args.common.say("mo-encode");
-    let encoded: Vec<(Features, Option<String>)> = clips.par_iter().map(|c| (m2m::encode(&c.motion), m2m::loss_warning(&c.motion, &c.skeleton))).collect();
-    let (features, warnings): (Vec<Features>, Vec<Option<String>>) = encoded.into_iter().unzip();
-    batch::check_stackable(&names(clips), &features).map_err(anyhow::Error::msg)?;
+    let (features, warnings) = encode::m2m(clips)?;
     let first = &clips[0];
     for (clip, (f, warning)) in clips.iter().zip(features.iter().zip(&warnings)) {
         if let Some(w) = warning {
@@ -414,52 +402,20 @@ fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
     output::write_all(&[(args.common.output.clone(), npy_bytes(clips, &features)?)])
 }
 
-/// The rig for encoding, the document that will carry it, and the name of where it came from:
-/// `--skeleton`'s record, else one built on AnyTop's rest pose of the inputs.
-fn encoding_rig(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<(SkeletonDocument, AnyTopSection, String)> {
+fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<()> {
+    let say = args.common.say("mo-encode");
+    encode::check_frames(clips)?;
     let first = &clips[0];
-    for clip in &clips[1..] {
-        input::same_skeleton(&first.name, &first.skeleton, &clip.name, &clip.skeleton)?;
-    }
+    // Checked in this order: the clips, the rest pose, the skeleton file.
+    encode::same_skeleton(clips)?;
     let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?.map(|(clip, _)| clip);
     if let Some(rest) = &rest_pose {
         input::same_skeleton(&first.name, &first.skeleton, &rest.name, &rest.skeleton)?;
     }
-    if let Some(path) = args.skeleton.as_deref() {
-        let file = read_skeleton(path)?;
-        input::same_skeleton(&first.name, &first.skeleton, &file.name, &file.skeleton)?;
-        let want_stats = args.normalise || args.emit_skeleton.is_some();
-        let section = file.record_with(rest_pose.as_ref(), &overrides(args), want_stats)?;
-        return Ok((file.document, section, file.name));
-    }
-    let (rest, choice) = clip::rest_pose(rest_pose.as_ref(), clips).expect("clips is not empty");
-    let file = rest.name.clone();
-    let source = match choice {
-        RestChoice::Explicit => RestSource::Explicit { file },
-        RestChoice::TPose => RestSource::TPose { file },
-        RestChoice::FirstClip => RestSource::FirstClip { file },
-    };
-    let options = overrides(args).resolve(&rest.skeleton, &rest.name, source).map_err(anyhow::Error::msg)?;
-    let section =
-        AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options).with_context(|| format!("{}: cannot build an AnyTop rig", rest.name))?;
-    // The document describes the encoded clips (their frame time), with the rig.
-    let document = SkeletonDocument::build(&first.skeleton, first_info, &first.name, topology::DEFAULT_DMAX);
-    Ok((document, section, rest.name.clone()))
-}
-
-fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) -> anyhow::Result<()> {
-    let say = args.common.say("mo-encode");
-    if let Some(clip) = clips.iter().find(|c| c.motion.frames < 2) {
-        bail!(
-            "{}: {} frame(s): AnyTop features need at least two frames (frame t's velocity comes from frame t+1, so F frames give F-1 feature frames; a one-frame rest pose goes to --rest-pose)",
-            clip.name,
-            clip.motion.frames
-        );
-    }
-    let first = &clips[0];
-    let (mut document, mut section, rig_name) = encoding_rig(args, clips, first_info)?;
-    let rig = &section.rig;
-    if rig.feet.is_empty() {
+    let file = args.skeleton.as_deref().map(read_skeleton).transpose()?;
+    let want_stats = args.normalise || args.emit_skeleton.is_some();
+    let mut rig = encode::Rig::choose(clips, first_info, rest_pose.as_ref(), file, &overrides(args), want_stats)?;
+    if rig.section.rig.feet.is_empty() {
         // Contacts are part of every AnyTop token; without feet they are all zero, which is
         // right for a fish but surprising for a walker whose feet the names did not reveal.
         if args.require_contacts {
@@ -467,40 +423,20 @@ fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) ->
         }
         say.warn(format_args!("{}: no foot joints found, so every contact feature is 0 (name them with --feet)", first.name));
     }
-    say.info(format_args!("rig: {}", rig.describe(&first.skeleton)));
-
-    let results: Vec<anyhow::Result<anytop::Encoded>> = clips
-        .par_iter()
-        .map(|c| rig.encode(&c.skeleton, &c.motion).with_context(|| format!("{}: cannot encode with the AnyTop rig of {rig_name}", c.name)))
-        .collect();
-    let encoded = results.into_iter().collect::<anyhow::Result<Vec<anytop::Encoded>>>()?;
-    let (mut features, placements): (Vec<Features>, Vec<Placement>) = encoded.into_iter().map(|e| (e.features, e.placement)).unzip();
-    batch::check_stackable(&names(clips), &features).map_err(anyhow::Error::msg)?;
+    say.info(format_args!("rig: {}", rig.section.rig.describe(&first.skeleton)));
+    let (mut features, placements) = rig.encode(clips)?;
     for (clip, f) in clips.iter().zip(&features) {
         let [n, j, d] = f.shape();
         say.info(format_args!("{}: {} frames, {j} joints -> anytop features [{n}, {j}, {d}]", clip.name, clip.motion.frames));
     }
-
-    // Statistics: of the given clips for --stats; --normalise and the emitted document use the
-    // record's when it has them (so that its --normalised decoding undoes this call's).
-    let record_has_stats = section.stats.is_some();
-    let need_clip_stats = args.stats.is_some() || (!record_has_stats && (args.normalise || args.emit_skeleton.is_some()));
-    let clip_stats = if need_clip_stats { Some(AnyTopStats::compute(features.iter()).context("computing the statistics")?) } else { None };
-    if !record_has_stats {
-        section.stats = clip_stats.clone();
-    }
-    if args.normalise {
-        let stats = section.stats.as_ref().expect("computed above when absent");
-        let source = if record_has_stats { rig_name.clone() } else { "the given clips".to_string() };
-        for f in &mut features {
-            stats.normalise(f).with_context(|| format!("normalising with the statistics of {source}"))?;
-        }
-        say.info(format_args!("normalised with the statistics of {source}"));
+    let stats = rig.statistics(&mut features, args.stats.is_some(), want_stats, args.normalise)?;
+    if let Some(from) = &stats.normalised_with {
+        say.info(format_args!("normalised with the statistics of {from}"));
     }
 
     let mut outputs = vec![(args.common.output.clone(), npy_bytes(clips, &features)?)];
     if let Some(path) = &args.stats {
-        let stats = clip_stats.as_ref().expect("computed for --stats");
+        let stats = stats.clips.as_ref().expect("computed for --stats");
         outputs.push((Some(path.clone()), json_line(stats)?));
     }
     if let Some(path) = &args.placement {
@@ -508,8 +444,8 @@ fn encode_anytop(args: &Args, clips: &[Clip], first_info: Option<MotionInfo>) ->
         outputs.push((Some(path.clone()), json.into_bytes()));
     }
     if let Some(path) = &args.emit_skeleton {
-        document.anytop = Some(section);
-        outputs.push((Some(path.clone()), json_line(&document)?));
+        rig.document.anytop = Some(rig.section);
+        outputs.push((Some(path.clone()), json_line(&rig.document)?));
     }
     output::write_all(&outputs)
 }
@@ -541,8 +477,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     let skeleton_path = args.skeleton.as_deref().context("--decode needs --skeleton")?;
     let arg = read_skeleton(skeleton_path)?;
     let skeleton = &arg.skeleton;
-    let name = io::display_name(&input);
-    let bytes = io::read_input(&input).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(&input)?;
     let array = npy::from_bytes(&bytes, &name)?;
     drop(bytes);
     let (samples, batch) = split_samples(array, &name).map_err(anyhow::Error::msg)?;
@@ -552,14 +487,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         Repr::Anytop => {
             let rest_pose = args.rest_pose.as_deref().map(|p| load_clip(p, Some(2))).transpose()?.map(|(clip, _)| clip);
             let section = arg.record_with(rest_pose.as_ref(), &overrides(args), args.normalised)?;
-            let stats = match (args.normalised, section.stats) {
-                (false, _) => None,
-                (true, Some(stats)) => Some(stats),
-                (true, None) => bail!(
-                    "--normalised: {} has no AnyTop statistics to undo the normalisation with (give --skeleton the document mo-encode --emit-skeleton wrote for these features)",
-                    arg.name
-                ),
-            };
+            let stats = decode::normalisation(section.stats, args.normalised, &arg.name)?;
             let placements = match args.placement.as_deref() {
                 Some(p) => read_placements(p, samples.len(), &name)?,
                 None => vec![section.rig.rest_placement(); samples.len()],
@@ -570,10 +498,8 @@ fn decode(args: &Args) -> anyhow::Result<()> {
     };
 
     // Check everything before writing anything.
-    let label = |i: usize| if batch { format!("{name}: sample {i}") } else { name.clone() };
-    for (i, f) in samples.iter().enumerate() {
-        decoder.check(f, skeleton).map_err(|(e, hint)| anyhow!("{}: {e} ({} features, skeleton {}){hint}", label(i), decoder.repr_name(), arg.name))?;
-    }
+    let batch = decode::Samples { name: &name, batch, features: &samples, skeleton, skeleton_name: &arg.name };
+    batch.check(&decoder)?;
     let target = args.common.output.as_deref();
     let paths: Vec<Option<PathBuf>> = if target.is_none_or(is_dash) {
         if samples.len() > 1 {
@@ -585,15 +511,7 @@ fn decode(args: &Args) -> anyhow::Result<()> {
         output::numbered(pattern, samples.len())?.into_iter().map(Some).collect()
     };
 
-    let texts: Vec<anyhow::Result<Vec<u8>>> = samples
-        .par_iter()
-        .enumerate()
-        .map(|(i, f)| {
-            let motion = decoder.decode(i, f, skeleton).map_err(|e| anyhow!("{}: {e}", label(i)))?;
-            crate::cli::load::motion_file(skeleton, &motion, paths[i].as_deref(), MotionFormat::Bvh)
-        })
-        .collect();
-    let texts = texts.into_iter().collect::<anyhow::Result<Vec<Vec<u8>>>>()?;
+    let texts = batch.decode_files(&decoder, &paths)?;
     let frames = samples.first().map_or(0, |f| f.frames);
     args.common.say("mo-encode").info(format_args!("{name}: {} sample(s) of {frames} frames decoded on {}", samples.len(), arg.name));
     output::write_all(&paths.into_iter().zip(texts).collect::<Vec<_>>())

@@ -8,15 +8,13 @@ use crate::binding::Binding;
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, read_skeleton, DecodeFrom, LoadOptions};
 use crate::cli::CommonOpts;
-use crate::document::AnyTopSection;
 use crate::io;
 use crate::metrics::generation::GenerationOptions;
 use crate::metrics::physics::{Ground, PhysicsOptions};
-use crate::metrics::report;
+use crate::metrics::{checks, report};
 use crate::motion::Clip;
-use crate::repr::anytop::RigOptions;
 use anyhow::{bail, Context};
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 const EXAMPLES: &str = "\
@@ -277,24 +275,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: bool) -> anyhow::Result<Value> {
     let device = candle_core::Device::Cpu;
     let known = if latent {
-        super::ood::Known::latent(model, &super::latent::load_model(model, &device)?.rigs)?
+        super::ood::Known::latent(model, &crate::sata::clips::frozen_or_default(model, &device)?.rigs)?
     } else {
         super::ood::Known::denoiser(model, &crate::diffusion::checkpoint::frozen_or_default(model, &device)?.info)?
     };
     if known.reference.profiles.is_empty() {
         bail!("{} records no training skeletons to compare with", known.model);
     }
-    let mut scored = Vec::new();
-    for path in skeletons {
-        let arg = read_skeleton(path)?;
-        scored.push(json!({ "skeleton": arg.name, "ood": known.score(&arg.name, &arg.skeleton)? }));
-    }
-    let mut report = json!({ "model": known.model, "limit": crate::ood::LIMIT, "skeletons": scored });
-    if args.common.verbose {
-        let within: Vec<Value> = known.reference.nearest_within().into_iter().map(|(a, b, d)| json!({ "skeleton": a, "nearest": b, "distance": d })).collect();
-        report["training"] = Value::Array(within);
-    }
-    Ok(report)
+    let skeletons = skeletons.iter().map(|p| read_skeleton(p).map(|f| (f.name, f.skeleton))).collect::<Result<Vec<_>, _>>()?;
+    Ok(known.reference.report(&known.model, &skeletons, args.common.verbose)?)
 }
 
 pub fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -> anyhow::Result<PhysicsOptions> {
@@ -329,18 +318,8 @@ fn run_physics(args: &Args, inputs: &[PathBuf], opts: &PhysicsOptions) -> anyhow
 fn run_reconstruction(args: &Args, reference: &Path, result: &Path, height: Option<f64>) -> anyhow::Result<Value> {
     let mut a = load_one(args, reference)?;
     let b = load_one(args, result)?;
-    if a.skeleton.len() != b.skeleton.len() {
-        bail!("{} has {} joints but {} has {}: reconstruction compares motions on one skeleton", a.name, a.skeleton.len(), b.name, b.skeleton.len());
-    }
-    // Features (and latents) of an F-frame clip describe F - 1 frames: the last one only gives
-    // velocities. So every encode -> decode round trip is one frame short; compare what it has.
-    if b.motion.frames + 1 == a.motion.frames {
-        let note = format!("{} has one frame fewer than {} (a decoded round trip); comparing its {} frames", b.name, a.name, b.motion.frames);
+    if let Some(note) = checks::reconstruction_pair(&mut a, &b)? {
         args.common.say("mo-metrics").note(note);
-        a.motion = a.motion.first_frames(b.motion.frames);
-    }
-    if a.motion.frames != b.motion.frames {
-        bail!("{} has {} frames but {} has {}: reconstruction compares frame by frame", a.name, a.motion.frames, b.name, b.motion.frames);
     }
     let height = match height {
         Some(h) if h.is_finite() && h > 0.0 => h,
@@ -362,11 +341,7 @@ fn run_transfer(
     let src = load_one(args, source)?;
     let results = load(args, results)?;
     let target = &results[0];
-    for r in &results[1..] {
-        if r.skeleton.len() != target.skeleton.len() {
-            bail!("{} has {} joints but {} has {}: all results must be on one skeleton", r.name, r.skeleton.len(), target.name, target.skeleton.len());
-        }
-    }
+    checks::one_target(&results)?;
     let pairs: Vec<(usize, usize)> = match binding {
         Some(path) => {
             let name = io::display_name(path);
@@ -377,9 +352,7 @@ fn run_transfer(
         }
         None => report::same_name_pairs(&src, target),
     };
-    if pairs.is_empty() {
-        bail!("{} and {} share no joint names: give --binding", src.name, target.name);
-    }
+    checks::some_pairs(&src, target, &pairs)?;
     let examples = if examples.is_empty() { Vec::new() } else { load(args, examples)? };
     let transfer = report::Transfer { source: &src, results: &results, pairs: &pairs, examples: &examples, seconds, fid_window };
     Ok(report::transfer_report(&transfer)?)
@@ -388,18 +361,12 @@ fn run_transfer(
 fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &GenerationOptions) -> anyhow::Result<Value> {
     let gt = load(args, gt)?;
     let gen = load(args, generated)?;
-    let first = &gt[0];
-    for l in gt.iter().chain(&gen) {
-        if l.skeleton.len() != first.skeleton.len() || l.skeleton.joints.iter().zip(&first.skeleton.joints).any(|(a, b)| a.parent != b.parent) {
-            bail!("{} and {} are not on the same skeleton: generation metrics compare clips of one skeleton", l.name, first.name);
-        }
-    }
+    checks::one_skeleton(&gt, &gen)?;
     // One rig for all clips, so positions share AnyTop's scale: the skeleton's own record
     // (--skeleton), else one built on the first ground-truth clip as AnyTop would.
     let section = match &args.skeleton {
         Some(p) => read_skeleton(p)?.record()?,
-        None => AnyTopSection::new(&first.skeleton, &first.motion.first_frames(2), &RigOptions::default())
-            .with_context(|| format!("{}: cannot build an AnyTop rig", first.name))?,
+        None => checks::generation_rig(&gt[0])?,
     };
     Ok(report::generation_report(&gt, &gen, &section, opts)?)
 }
@@ -407,8 +374,7 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
 fn run_aggregate(paths: &[PathBuf]) -> anyhow::Result<Value> {
     let mut reports = Vec::new();
     for path in paths {
-        let name = io::display_name(path);
-        let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+        let (name, bytes) = io::read_named(path)?;
         let v: Value = serde_json::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{name}: not JSON: {e}"))?;
         reports.push((name, v));
     }

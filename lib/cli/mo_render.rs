@@ -12,7 +12,7 @@ use crate::render::html::{render_html, HtmlOptions};
 use crate::render::labels::{self, FrameLabels, JointLabels};
 use crate::render::sheet::{render_sheet, SheetOptions};
 use crate::render::{Legend, Track, View};
-use anyhow::{bail, Context};
+use anyhow::bail;
 use std::path::{Path, PathBuf};
 
 const EXAMPLES: &str = "\
@@ -196,8 +196,7 @@ fn kind_of_extension(p: &Path) -> Option<Kind> {
 }
 
 fn read_text(path: &Path) -> anyhow::Result<String> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(path)?;
     String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))
 }
 
@@ -222,13 +221,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if loaded.is_empty() {
         bail!("no motion to draw");
     }
-    if let Some((FrameLabels::Segments(segments), file)) = &frame_labels {
-        // Segments are frames of the drawn motions: one past the longest is a label file
-        // for another motion.
-        let longest = loaded.iter().map(|l| l.motion.frames).max().unwrap_or(0);
-        if let Some((i, (_, end, _))) = segments.iter().enumerate().find(|(_, (_, end, _))| *end > longest) {
-            bail!("{file}: segment {i} ends at frame {end}, but the longest motion has {longest} frames");
-        }
+    if let Some((labels, file)) = &frame_labels {
+        labels.check_fits(loaded.iter().map(|l| l.motion.frames).max().unwrap_or(0), file)?;
     }
     let (first_frame, mut tracks) = Track::from_clips(&loaded, args.frames).map_err(anyhow::Error::msg)?;
     let skeletons: Vec<_> = loaded.iter().map(|l| &l.skeleton).collect();

@@ -6,10 +6,11 @@
 use crate::binding::auto;
 use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, motion_file, read_bvh_clip, read_example_clips};
+use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
 use crate::cli::output::{self, OutFormat};
 use crate::cli::CommonOpts;
 use crate::io;
+use crate::motion::write::motion_file;
 use crate::motion::Clip;
 use crate::motion::Motion;
 use crate::repr::m2m;
@@ -195,15 +196,16 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     }
     let started = Instant::now();
     let device = candle_core::Device::Cpu;
-    let model = super::latent::load_model(args.model.as_deref(), &device)?;
+    let model = crate::sata::clips::frozen_or_default(args.model.as_deref(), &device)?;
     let source = super::latent::read_source(&args.source, &model, &device)?;
-    let target = super::latent::read_target(&target_path, &model, &device)?;
+    let target = crate::sata::clips::Target::new(read_skeleton(&target_path)?, &model, &device)?;
     let known = super::ood::Known::latent(args.model.as_deref(), &model.rigs)?;
     for (name, skeleton) in [(&source.name, &source.skeleton), (&target.file.name, &target.file.skeleton)] {
         known.warn("mo-retarget", name, skeleton, args.common.quiet)?;
     }
-    let latents = super::latent::encode(&model, &source, &device)?;
-    let bytes = super::latent::decode_file(&model, &latents, &target, source.motion.frame_time, &device, args.common.output.as_deref(), args.format.motion())?;
+    let latents = source.encode(&model, &device)?;
+    let motion = target.decode(&model, &latents, source.motion.frame_time, &device)?;
+    let bytes = motion_file(&target.file.skeleton, &motion, args.common.output.as_deref(), args.format.motion())?;
     if args.report {
         eprintln!(
             "mo-retarget: latent: {} ({} joints) -> {} ({} joints), {} frames, latent {} per frame, {:.2} s",
@@ -304,7 +306,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.emit_binding {
         return Ok(io::write_output(outputs[0].as_deref(), binding.to_json().as_bytes())?);
     }
-    let source_motion = at_rate_of(&source, first, args.common.say("mo-retarget"))?;
+    let (source_motion, resampled) = retarget::clips::at_rate_of(&source, first, bounds::MAX_FRAMES)?;
+    if let (Some((from, to)), false) = (resampled, args.common.quiet) {
+        eprintln!("mo-retarget: {}: resampling {from:.3} fps to the examples' {to:.3} fps", source.name);
+    }
     let settings = settings(args, 1.0 / first.motion.frame_time, source_motion.frames)?;
     let out_frames = settings.frames.unwrap_or(source_motion.frames);
     if out_frames > bounds::MAX_FRAMES {
@@ -338,21 +343,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     if args.report && !args.common.quiet {
         let say = |line: &str| eprintln!("mo-retarget: {line}");
-        say(&format!(
-            "{} ({} frames, {} joints) -> {} ({} example clip(s), {} frames, {} joints)",
-            source.name,
-            source_motion.frames,
-            source.skeleton.len(),
-            first.name,
-            examples.len(),
-            examples.iter().map(|e| e.motion.frames).sum::<usize>(),
-            first.skeleton.len()
-        ));
-        say(&format!("binding: {} pairs, rate {:.1}%", map.len(), 100.0 * Binding::rate(map.len(), source.skeleton.len(), first.skeleton.len())));
-        for (p, &(s, t)) in binding.mapping.iter().zip(&map) {
-            let score = p.score.map(|x| format!(" (score {x:.3})")).unwrap_or_default();
-            say(&format!("  {} -> {}{score}", source.skeleton.joints[s].name, first.skeleton.joints[t].name));
-        }
+        retarget::clips::describe(&source, source_motion.frames, &examples, &map, &binding).iter().for_each(|line| say(line));
         for (i, r) in results.iter().enumerate() {
             r.report.describe(i, seeds[i]).iter().for_each(|line| say(line));
         }
@@ -378,16 +369,12 @@ fn output_paths(args: &Args, count: usize) -> anyhow::Result<Vec<Option<PathBuf>
 /// The source and the target's example clips, each at least two frames long.
 fn read_inputs(args: &Args) -> anyhow::Result<(Clip, Vec<Clip>)> {
     let source = read_bvh_clip(&args.source, "mo-retarget")?;
-    if source.motion.frames < 2 {
-        bail!("{}: {} frame(s): a source motion needs at least two frames", source.name, source.motion.frames);
-    }
+    retarget::clips::check_lengths(&source, &[])?;
     if args.targets.iter().any(|p| is_dash(p)) && is_dash(&args.source) {
         bail!("stdin ('-') can be read only once");
     }
     let examples = read_example_clips(&args.targets, "mo-retarget", "target clips")?;
-    if let Some(e) = examples.iter().find(|e| e.motion.frames < 2) {
-        bail!("{}: {} frame(s): example clips need at least two frames", e.name, e.motion.frames);
-    }
+    retarget::clips::check_lengths(&source, &examples)?;
     Ok((source, examples))
 }
 
@@ -405,28 +392,4 @@ fn binding_for(bind: &str, source: &Clip, first: &Clip, rate: Option<f64>) -> an
         .map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))?;
     let binding = Binding::from_json(&text, &name)?;
     Ok((binding.resolve(&name, &source.skeleton, &source.name, &first.skeleton, &first.name)?, binding))
-}
-
-/// The source's motion at the examples' frame rate (resampled, with a note, when it differs).
-fn at_rate_of(source: &Clip, first: &Clip, say: output::Say) -> anyhow::Result<Motion> {
-    let target_fps = 1.0 / first.motion.frame_time;
-    let source_fps = 1.0 / source.motion.frame_time;
-    if (source_fps - target_fps).abs() <= 1e-6 * target_fps {
-        return Ok(source.motion.clone());
-    }
-    let frames = (source.motion.frames - 1) as f64 * source.motion.frame_time * target_fps + 1.0;
-    if !(frames <= bounds::MAX_FRAMES as f64) {
-        bail!(
-            "{}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps ({}: Frame Time {}) would give {frames:.0} frames, more than {}",
-            source.name,
-            first.name,
-            first.motion.frame_time,
-            bounds::MAX_FRAMES
-        );
-    }
-    crate::budget::check_motion(&format!("{}: resampling", source.name), frames as usize, source.skeleton.len())?;
-    if !say.quiet {
-        eprintln!("mo-retarget: {}: resampling {source_fps:.3} fps to the examples' {target_fps:.3} fps", source.name);
-    }
-    Ok(retarget::resample(&source.motion, target_fps))
 }

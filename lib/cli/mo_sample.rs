@@ -6,11 +6,11 @@ use crate::cli::{output, CommonOpts};
 use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit::{self, KeepMask};
+use crate::diffusion::keep::{Kept, Reference};
 use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
 use crate::diffusion::Sampler;
 use crate::io;
 use crate::repr::anytop::{AnyTopRig, IkOptions, Placement};
-use crate::repr::smooth::lambda_for_cutoff;
 use crate::repr::Features;
 use anyhow::{bail, Context};
 use candle_core::Device;
@@ -39,6 +39,14 @@ pub const DEFAULT_SMOOTH_HZ: f64 = 7.0;
 
 /// Frames per sample (`--frames`, `--seconds`): the denoiser attends over all frames at once.
 pub const MAX_SAMPLE_FRAMES: u64 = 10_000;
+
+/// `--seconds S` as frames at `fps`, at most `MAX_SAMPLE_FRAMES` (both ways of sampling).
+pub fn sample_frames(seconds: f64, fps: f64) -> anyhow::Result<usize> {
+    match crate::cli::bounds::frames_for_seconds(seconds, fps).map_err(anyhow::Error::msg)? {
+        n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {seconds} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
+        n => Ok(n),
+    }
+}
 
 /// The default `--blend`: half a second (15 frames at 30 fps), the order of a step.
 pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
@@ -175,14 +183,6 @@ pub struct Args {
     pub common: CommonOpts,
 }
 
-/// The reference clip of an edit, encoded on the sampled skeleton's rig.
-struct Reference {
-    name: String,
-    /// Physical units, `[bvh frames − 1, joints, 13]`.
-    features: Features,
-    placement: crate::repr::anytop::Placement,
-}
-
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SamplerArg {
     Ddpm,
@@ -227,10 +227,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => None,
     };
     let frames = match args.seconds {
-        Some(s) => match crate::cli::bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
-            n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
-            n => n,
-        },
+        Some(s) => sample_frames(s, fps)?,
         None => match (args.frames, &reference) {
             (Some(n), _) => n as usize,
             (None, Some(r)) => r.features.frames,
@@ -248,11 +245,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         eprintln!("mo-sample: {}: not a trained skeleton and no statistics in it: normalising by its rest pose and the trained skeletons' spreads", arg.name);
     }
     let cond = condition.condition();
-    let lambda = smoothing(args.smooth, fps)?;
-    if !(args.blend.is_finite() && args.blend >= 0.0 && args.blend <= crate::cli::bounds::MAX_SECONDS) {
-        bail!("--blend must be a duration in seconds (>= 0), found {}", args.blend);
-    }
-    let blend = (args.blend * fps).round() as usize;
+    let post = PostProcess::new(args.smooth, args.blend, !args.no_plant_feet, fps, crate::cli::bounds::MAX_SECONDS)?;
     let schedule = loaded.info.schedule();
     let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler: args.sampler.sampler(), seed: args.common.seed };
     let started = std::time::Instant::now();
@@ -261,7 +254,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
     };
     let fixed = mask.as_ref().map(|m| m.keep.as_slice());
-    let post = PostProcess { smooth: lambda, blend, plant_feet: !args.no_plant_feet };
     for f in &mut samples {
         post.apply(f, &section.rig.feet, fixed);
     }
@@ -291,7 +283,7 @@ fn write_samples(
             let mut files = Vec::with_capacity(paths.len());
             for (i, (f, path)) in samples.iter().zip(paths).enumerate() {
                 let motion = rig.decode_ik(skeleton, f, placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
-                let bytes = crate::cli::load::motion_file(skeleton, &motion, Some(&path), crate::cli::load::MotionFormat::Bvh)?;
+                let bytes = crate::motion::write::motion_file(skeleton, &motion, Some(&path), crate::cli::load::MotionFormat::Bvh)?;
                 files.push((Some(path), bytes));
             }
             output::write_all(&files)
@@ -300,20 +292,6 @@ fn write_samples(
             output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
             Ok(io::write_output(args.common.output.as_deref(), &output::features_npy(samples, true)?)?)
         }
-    }
-}
-
-/// The smoother's weight for `--smooth HZ` at `fps`; `None` for 0 (raw output).
-fn smoothing(hz: f64, fps: f64) -> anyhow::Result<Option<f64>> {
-    if hz == 0.0 {
-        return Ok(None);
-    }
-    if !hz.is_finite() || hz < 0.0 {
-        bail!("--smooth must be a cutoff in Hz (>= 0; 0 = no smoothing), found {hz}");
-    }
-    match lambda_for_cutoff(hz, fps) {
-        Some(lambda) => Ok(Some(lambda)),
-        None => bail!("--smooth {hz}: the cutoff must be below half the frame rate ({:.1} Hz at {fps:.1} fps); 0 = no smoothing", fps / 2.0),
     }
 }
 
@@ -331,33 +309,12 @@ fn read_reference(
         e @ crate::motion::ClipError::Skeleton { .. } => anyhow::Error::new(e),
         e => anyhow::Error::new(e).context(format!("the reference {name}")),
     })?;
-    if let Some(diff) = skeleton.first_difference(&clip.skeleton) {
-        bail!("the reference {name} is not on the skeleton of {skeleton_name}: {diff}");
-    }
-    let motion = clip.motion;
-    if motion.frames < 2 {
-        bail!("the reference {name} has {} frame(s); AnyTop features need at least 2", motion.frames);
-    }
-    let encoded = rig.encode(skeleton, &motion).map_err(|e| anyhow::anyhow!("the reference {name}: {e}"))?;
-    Ok(Reference { name, features: encoded.features, placement: encoded.placement })
+    Ok(Reference::encode(clip, skeleton_name, skeleton, rig)?)
 }
 
-/// The cells `--keep-frames` and `--keep-joints` keep: frames must exist in both the output and
-/// the reference; joints are kept over every output frame the reference has.
+/// The cells `--keep-frames` and `--keep-joints` keep (`diffusion::keep`): frames must exist in
+/// both the output and the reference; joints are kept over every output frame the reference has.
 fn keep_mask(args: &Args, r: &Reference, skeleton: &crate::skeleton::Skeleton, frames: usize) -> anyhow::Result<KeepMask> {
-    let mut mask = KeepMask::new(frames, skeleton.len());
-    let known = frames.min(r.features.frames);
-    if let Some(text) = &args.keep_frames {
-        let why = format!("the output has {frames} frames, the reference {} has {} frames of features", r.name, r.features.frames);
-        let ranges = edit::parse_frame_ranges(text, known, &why).context("--keep-frames")?;
-        mask.keep_frames(&ranges);
-    }
-    if let Some(list) = &args.keep_joints {
-        let joints = edit::select_joints(skeleton, list).context("--keep-joints")?;
-        mask.keep_joints(&joints, 0..known);
-    }
-    if mask.count() == mask.keep.len() {
-        bail!("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate");
-    }
-    Ok(mask)
+    let why = format!("the output has {frames} frames, the reference {} has {} frames of features", r.name, r.features.frames);
+    Ok(Kept::resolve(args.keep_frames.as_deref(), args.keep_joints.as_deref(), skeleton, frames, r.features.frames, &why)?.mask())
 }

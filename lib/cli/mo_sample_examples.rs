@@ -3,10 +3,10 @@
 //! `genmm::Settings` and a `genmm::Keep`, runs `genmm::generate` (one seed per sample), and
 //! writes BVH on the examples' skeleton or Motion2Motion features, all outputs or none.
 
-use super::mo_sample::{Args, MAX_SAMPLE_FRAMES};
+use super::mo_sample::{sample_frames, Args};
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
-use crate::cli::{bounds, output};
-use crate::diffusion::edit;
+use crate::cli::output;
+use crate::diffusion::keep::Kept;
 use crate::genmm::{self, Keep, Settings};
 use crate::io;
 use crate::motion::Clip;
@@ -39,10 +39,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let fps = if frame_time > 0.0 { 1.0 / frame_time } else { 30.0 };
     let reference = args.reference.as_deref().map(|path| read_reference(path, first)).transpose()?;
     let frames = match (args.seconds, args.frames, &reference) {
-        (Some(s), _, _) => match bounds::frames_for_seconds(s, fps).map_err(anyhow::Error::msg)? {
-            n if n as u64 > MAX_SAMPLE_FRAMES => bail!("--seconds {s} is {n} frames at {fps:.3} fps, more than the {MAX_SAMPLE_FRAMES} a sample may have"),
-            n => n,
-        },
+        (Some(s), _, _) => sample_frames(s, fps)?,
         (None, Some(n), _) => n as usize,
         (None, None, Some(r)) => r.motion.frames,
         (None, None, None) => clips.iter().map(|c| c.motion.frames).max().unwrap_or(1),
@@ -58,16 +55,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let generation = generated_at.elapsed();
 
     if args.report {
-        eprintln!("{}", report(&clips, &generated, generation));
+        eprintln!("{}", genmm::clips::report(&clips, &generated, generation));
     }
     let say = args.common.say("mo-sample");
     say.info(format_args!("{count} x {frames} frames from {} example clip(s) in {:.3} s", clips.len(), generation.as_secs_f64()));
     if !args.common.quiet {
-        let mut notes: Vec<&String> = generated.iter().flat_map(|g| &g.report.notes).collect();
-        notes.dedup();
-        notes.sort();
-        notes.dedup();
-        for note in notes {
+        for note in genmm::clips::notes(&generated) {
             say.note(note);
         }
     }
@@ -77,7 +70,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let files = generated
                 .iter()
                 .zip(paths)
-                .map(|(g, p)| Ok((Some(p.clone()), crate::cli::load::motion_file(skeleton, &g.motion, Some(&p), crate::cli::load::MotionFormat::Bvh)?)))
+                .map(|(g, p)| Ok((Some(p.clone()), crate::motion::write::motion_file(skeleton, &g.motion, Some(&p), crate::cli::load::MotionFormat::Bvh)?)))
                 .collect::<anyhow::Result<Vec<_>>>()?;
             output::write_all(&files)?;
         }
@@ -94,77 +87,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// `--reference`: a clip of the examples' skeleton at their frame rate.
 fn read_reference(path: &std::path::Path, first: &Clip) -> anyhow::Result<Clip> {
     let r = read_bvh_clip(path, "mo-sample --reference")?;
-    if let Some(why) = first.skeleton.first_difference(&r.skeleton) {
-        bail!("the reference {} is not on the skeleton of the example clips ({}): {why}", r.name, first.name);
-    }
-    let (a, b) = (r.motion.frame_time, first.motion.frame_time);
-    if (a - b).abs() > 1e-6 * b {
-        bail!(
-            "the reference {} runs at {:.3} fps but the example clips ({}) at {:.3} fps: give a reference of their frame rate",
-            r.name,
-            1.0 / a,
-            first.name,
-            1.0 / b
-        );
-    }
-    if r.motion.frames == 0 {
-        bail!("the reference {} has no frames", r.name);
-    }
+    genmm::clips::check_reference(first, &r)?;
     Ok(r)
 }
 
-/// What `--keep-frames` and `--keep-joints` keep: frames must exist in both the output and the
-/// reference; joints are kept over every output frame the reference has.
+/// What `--keep-frames` and `--keep-joints` keep (`diffusion::keep`).
 fn keep<'a>(args: &Args, r: &'a Clip, frames: usize) -> anyhow::Result<Keep<'a>> {
-    let known = frames.min(r.motion.frames);
-    let mut kept_frames = vec![false; frames];
-    if let Some(text) = &args.keep_frames {
-        let why = format!("the output has {frames} frames, the reference {} has {}", r.name, r.motion.frames);
-        for range in edit::parse_frame_ranges(text, known, &why).context("--keep-frames")? {
-            kept_frames[range].iter_mut().for_each(|k| *k = true);
-        }
-    }
-    let mut joints = vec![false; r.skeleton.len()];
-    if let Some(list) = &args.keep_joints {
-        for j in edit::select_joints(&r.skeleton, list).context("--keep-joints")? {
-            joints[j] = true;
-        }
-    }
-    let every_frame = kept_frames.iter().all(|&k| k);
-    let every_joint = known == frames && joints.iter().all(|&k| k);
-    if every_frame || every_joint {
-        bail!("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate");
-    }
-    Ok(Keep { reference: &r.motion, frames: kept_frames, joints })
-}
-
-/// `--report`: the synthesis of every sample, one JSON line.
-fn report(clips: &[Clip], generated: &[genmm::Generated], time: std::time::Duration) -> String {
-    let samples: Vec<serde_json::Value> = generated
-        .iter()
-        .map(|g| {
-            let levels: Vec<serde_json::Value> = g
-                .report
-                .levels
-                .iter()
-                .map(|l| serde_json::json!({ "frames": l.frames, "example_patches": l.example_patches, "match_costs": l.step_costs }))
-                .collect();
-            serde_json::json!({
-                "seed": g.report.seed,
-                "frames": g.report.frames,
-                "patch": g.report.patch,
-                "levels": levels,
-                "synthesis_ms": g.report.synthesis.as_secs_f64() * 1e3,
-                "notes": g.report.notes,
-            })
-        })
-        .collect();
-    serde_json::json!({
-        "report": "genmm",
-        "examples": clips.iter().map(|c| &c.name).collect::<Vec<_>>(),
-        "example_frames": clips.iter().map(|c| c.motion.frames).sum::<usize>(),
-        "generation_ms": time.as_secs_f64() * 1e3,
-        "samples": samples,
-    })
-    .to_string()
+    let why = format!("the output has {frames} frames, the reference {} has {}", r.name, r.motion.frames);
+    let kept = Kept::resolve(args.keep_frames.as_deref(), args.keep_joints.as_deref(), &r.skeleton, frames, r.motion.frames, &why)?;
+    Ok(Keep { reference: &r.motion, frames: kept.frames, joints: kept.joints })
 }

@@ -5,16 +5,14 @@
 //! writes JSON that `mo-render --frame-labels` reads.
 
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, read_skeleton, split_samples};
+use crate::cli::load::{is_dash, read_skeleton};
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
 use crate::dift::DiftOptions;
 use crate::io::{self, npy};
-use crate::motion::Clip;
-use crate::repr::anytop::FEATURE_DIMS;
-use crate::segment::input::{dift_features, raw_features, segment_input, usable_frame_time, window_frames, Input};
-use crate::segment::{SegmentOptions, Segmentation};
-use anyhow::{bail, Context};
+use crate::segment::input::{dift_features, raw_features, segment_input, window_frames, Input};
+use crate::segment::SegmentOptions;
+use anyhow::bail;
 use std::path::PathBuf;
 
 const EXAMPLES: &str = "\
@@ -165,7 +163,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             started.elapsed().as_secs_f64()
         );
     }
-    let text = report(args, &input, &options, &result)?;
+    let text = crate::segment::report::report(&input, args.features.name(), &options, args.common.seed, &result)?;
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
@@ -175,76 +173,16 @@ fn load(args: &Args) -> anyhow::Result<Input> {
     if is_dash(&args.input) && args.skeleton.as_deref().is_some_and(is_dash) {
         bail!("stdin ('-') can be read only once, but the input and --skeleton both read it");
     }
-    let name = io::display_name(&args.input);
-    let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
+    let (name, bytes) = io::read_named(&args.input)?;
     let skeleton = match &args.skeleton {
         Some(path) => Some(read_skeleton(path)?),
         None => None,
     };
     if !npy::looks_like_npy(&args.input, &bytes) {
-        let Clip { skeleton: own, motion, .. } = crate::cli::load::clip_from_bytes(&bytes, &name, &args.input)?;
+        let clip = crate::cli::load::clip_from_bytes(&bytes, &name, &args.input)?;
         drop(bytes);
-        return match skeleton {
-            // The skeleton's own record, so the features are those mo-encode makes with it.
-            Some(arg) => {
-                if let Some(diff) = arg.skeleton.first_difference(&own) {
-                    bail!("{name} is not on the skeleton of {}: {diff}", arg.name);
-                }
-                let section = arg.record()?;
-                Ok(Input::with_record(name, own, motion, section)?)
-            }
-            None => Ok(Input::from_motion(name, own, motion)?),
-        };
+        return Ok(Input::from_clip(clip, skeleton)?);
     }
-    let (mut samples, batch) = split_samples(npy::from_bytes(&bytes, &name)?, &name).map_err(anyhow::Error::msg)?;
-    if batch {
-        bail!("{name}: a batch of {} samples; mo-segment takes one motion (a [frames, joints, 13] array)", samples.len());
-    }
-    let anytop = samples.remove(0);
-    if anytop.dims != FEATURE_DIMS {
-        bail!("{name}: expected AnyTop features with {FEATURE_DIMS} values per joint (mo-encode's default), found {}", anytop.dims);
-    }
-    if anytop.frames == 0 {
-        bail!("{name}: the features have no frames");
-    }
-    let (skeleton, frame_time) = match skeleton {
-        Some(arg) => {
-            if anytop.joints != arg.skeleton.len() {
-                bail!("{name}: the features have {} joints but the skeleton {} has {}", anytop.joints, arg.name, arg.skeleton.len());
-            }
-            let frame_time = arg.motion.as_ref().map_or(1.0 / 30.0, |m| usable_frame_time(m.frame_time));
-            let section = arg.record()?;
-            (Some((arg.skeleton, section)), frame_time)
-        }
-        None => (None, 1.0 / 30.0),
-    };
-    Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton })
-}
-
-/// The JSON report: one key per line, values compact (a per-frame label list stays one line).
-fn report(args: &Args, input: &Input, options: &SegmentOptions, s: &Segmentation) -> anyhow::Result<String> {
-    use serde_json::to_string;
-    let explained = (s.explained_variance * 1e6).round() / 1e6;
-    let fields: Vec<(&str, String)> = vec![
-        ("file", to_string(&input.name)?),
-        ("frames", to_string(&input.frames)?),
-        ("frame_time", to_string(&input.frame_time)?),
-        ("features", to_string(&args.features.name())?),
-        ("k", to_string(&options.k)?),
-        ("clusters", to_string(&s.clusters)?),
-        ("pca_dims", to_string(&s.pca_dims)?),
-        ("explained_variance", to_string(&explained)?),
-        ("window_frames", to_string(&options.window)?),
-        ("min_segment", to_string(&options.min_segment)?),
-        ("seed", to_string(&args.common.seed)?),
-        ("labels", to_string(&s.labels)?),
-        ("segments", to_string(&s.segments)?),
-    ];
-    let mut out = String::from("{\n");
-    for (i, (key, value)) in fields.iter().enumerate() {
-        let comma = if i + 1 < fields.len() { "," } else { "" };
-        out.push_str(&format!("  \"{key}\": {value}{comma}\n"));
-    }
-    out.push_str("}\n");
-    Ok(out)
+    let array = npy::from_bytes(&bytes, &name)?;
+    Ok(Input::from_npy(name, array, skeleton)?)
 }

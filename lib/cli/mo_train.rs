@@ -4,9 +4,7 @@ use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, TrainSet};
-use crate::diffusion::trainer::{
-    refuse_existing, train_loop, AnyTopInit, AnyTopOptions, AnyTopResume, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer,
-};
+use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::embed::NameTable;
 use crate::nn::DenoiserConfig;
 use crate::sata::trainer::{SataOptions, SataResume, SataTrainer};
@@ -241,25 +239,6 @@ fn catch_interrupts() -> anyhow::Result<()> {
     installed.clone().map_err(|e| anyhow::anyhow!("cannot catch Ctrl-C: {e}"))
 }
 
-/// Seconds as `1h02m`, `3m05s` or `42s`.
-fn duration(seconds: f64) -> String {
-    if !seconds.is_finite() {
-        return "?".into();
-    }
-    let s = seconds.max(0.0).round() as u64;
-    match s {
-        0..=59 => format!("{s}s"),
-        60..=3599 => format!("{}m{:02}s", s / 60, s % 60),
-        _ => format!("{}h{:02}m", s / 3600, (s % 3600) / 60),
-    }
-}
-
-/// `[######..............]` for `done` of `total`, `width` cells inside the brackets.
-fn bar(done: u64, total: u64, width: usize) -> String {
-    let filled = if total == 0 { width } else { ((done.min(total) as u128 * width as u128) / total as u128) as usize };
-    format!("[{}{}]", "#".repeat(filled), ".".repeat(width - filled))
-}
-
 /// The learning rate of a fine-tune (`--init`) when none is given.
 pub const INIT_LR: f64 = 3e-4;
 
@@ -332,29 +311,9 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
     refuse_to_overwrite(args)?;
     // The checkpoint first: a resumed run must rebuild the data (augmented variants
     // included) from the seed the run started with.
-    let start = if args.resume {
-        let resume = AnyTopResume::load(&args.out, resolved.lr, device)?;
-        if resume.differs(&opts) {
-            say(args, "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been");
-        }
-        if let Some((old, new)) = resume.shift_changes(&opts) {
-            say(args, &format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
-        }
-        if let Some((old, new)) = resume.weighting_changes(&opts) {
-            say(args, &format!("note: the checkpoint was trained with --loss-weighting {old}; it goes on learning under {new}"));
-        }
-        AnyTopStart::Resume(resume)
-    } else if let Some(init) = &args.init {
-        let init = if init.as_os_str() == "builtin" { AnyTopInit::builtin(device)? } else { AnyTopInit::load(init, device)? };
-        say(args, &format!("fine-tuning {} (its size and noise schedule; --preset is not used)", init.source()));
-        AnyTopStart::Init(init)
-    } else {
-        AnyTopStart::New
-    };
-    let seed = match &start {
-        AnyTopStart::Resume(r) => r.info().seed,
-        _ => opts.seed,
-    };
+    let (start, notes) = AnyTopStart::choose(&args.out, args.resume, args.init.as_deref(), resolved.lr, &opts, device)?;
+    notes.iter().for_each(|note| say(args, note));
+    let seed = start.seed(&opts);
     let set = training_set(args, resolved, seed, start.dmax())?;
     let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, device).map_err(explain)?;
     train(args, resolved, trainer.first_step(), &mut trainer)
@@ -362,11 +321,10 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
 
 /// `--arch sata`: a new or resumed latent autoencoder; returns the steps done.
 fn train_sata(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Result<u64> {
-    let mut config = args.preset.sata();
-    if let Some(crop) = args.crop {
-        config.window = crop as usize;
-        config.overlap = config.overlap.min(config.window.saturating_sub(1) / 2);
-    }
+    let config = match args.crop {
+        Some(crop) => args.preset.sata().with_window(crop as usize),
+        None => args.preset.sata(),
+    };
     let opts = SataOptions {
         config,
         seed: args.common.seed,
@@ -428,26 +386,14 @@ fn train(args: &Args, resolved: &Resolved, first: u64, trainer: &mut impl Traine
     let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr()) && !args.common.quiet;
     let mut last_draw: Option<Instant> = None;
     let result = train_loop(&opts, first, trainer, &STOP, |p| {
-        let (step, steps, loss, rate, eta) = (p.step, p.steps, p.loss, p.rate, duration(p.eta_seconds));
-        // With a time budget the bar fills with time, and the step count has no total
-        // unless --steps set one.
-        let last = step == steps || p.budget_used.is_some_and(|u| u >= 1.0);
-        let count = match (p.budget_used, args.steps) {
-            (Some(_), None) => format!("step {step}"),
-            _ => format!("step {step:>width$}/{steps}", width = steps.to_string().len()),
-        };
-        let (done, total, left) = match p.budget_used {
-            Some(u) => ((u * 1000.0).round() as u64, 1000, format!("{eta} left")),
-            None => (step, steps, format!("ETA {eta}")),
-        };
         if terminal {
             // Redraw at most ten times a second: fast tiny models would flood the terminal.
-            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || last {
-                eprint!("\rmo-train: {} {count}  loss {loss:.4}  {rate:.2} steps/s  {left}   ", bar(done, total, 30));
+            if last_draw.is_none_or(|t| t.elapsed() >= Duration::from_millis(100)) || p.is_last() {
+                eprint!("\rmo-train: {} {}   ", p.bar(30), p.status(args.steps.is_some()));
                 last_draw = Some(Instant::now());
             }
-        } else if !args.common.quiet && (step % 50 == 0 || last) {
-            eprintln!("mo-train: {count}  loss {loss:.4}  {rate:.2} steps/s  {left}");
+        } else if !args.common.quiet && (p.step % 50 == 0 || p.is_last()) {
+            eprintln!("mo-train: {}", p.status(args.steps.is_some()));
         }
     });
     if terminal {
@@ -468,21 +414,12 @@ fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> any
     for d in &dropped {
         say(format!("{d}: too short to crop, left out"));
     }
-    say(format!(
-        "{} skeletons ({}), {} clips, {} feature frames; {} augmented variants",
-        set.skeletons.len(),
-        set.skeletons.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "),
-        set.skeletons.iter().map(|s| s.clips.len()).sum::<usize>(),
-        set.skeletons.iter().flat_map(|s| &s.clips).map(|c| c.frames).sum::<usize>(),
-        set.variant_count()
-    ));
+    say(set.summary());
     for v in &set.skipped_variants {
         say(format!("augmented variant left out: {v}"));
     }
     if args.common.verbose {
-        for v in set.augmented.iter().flatten() {
-            say(format!("variant {}: {} joints, {} clips", v.name, v.skeleton.len(), v.clips.len()));
-        }
+        set.variant_lines().into_iter().for_each(say);
     }
     Ok(set)
 }

@@ -2,11 +2,9 @@
 //! model's training skeletons as a reference, and one stderr line for a skeleton out of range.
 
 use crate::diffusion::checkpoint::CheckpointInfo;
-use crate::embed::NameTable;
-use crate::ood::{warning, Profile, Reference, Score};
+use crate::ood::{warning, Reference, Score};
 use crate::sata::rigs::KnownRigs;
 use crate::skeleton::Skeleton;
-use glam::DVec3;
 use std::path::Path;
 
 /// A model's training skeletons, profiled once per run, and how messages name the model.
@@ -15,37 +13,23 @@ pub struct Known {
     pub model: String,
 }
 
-/// Name, joint names, parents and rest offsets of one recorded training skeleton.
-type Recorded<'a> = (&'a str, &'a [String], &'a [Option<usize>], &'a [[f64; 3]]);
-
 impl Known {
-    fn new<'a>(model: String, recorded: impl Iterator<Item = Recorded<'a>>) -> anyhow::Result<Known> {
-        let table = NameTable::builtin()?;
-        let profiles = recorded
-            .filter(|(_, joints, _, offsets)| offsets.len() == joints.len())
-            .map(|(name, joints, parents, offsets)| {
-                Profile::new(name, joints, parents, &offsets.iter().map(|o| DVec3::from_array(*o)).collect::<Vec<_>>(), table)
-            })
-            .collect();
-        Ok(Known { reference: Reference { profiles }, model })
-    }
-
     /// The diffusion model's training skeletons (as its checkpoint records them); `dir` is the
     /// model's directory, none for the built-in one.
     pub fn denoiser(dir: Option<&Path>, info: &CheckpointInfo) -> anyhow::Result<Known> {
         let model = model_label(dir, crate::diffusion::checkpoint::BUILTIN_NAME);
-        Known::new(model, info.skeletons.iter().map(|t| (t.name.as_str(), t.joints.as_slice(), t.parents.as_slice(), t.offsets.as_slice())))
+        Ok(Known { reference: info.ood_reference()?, model })
     }
 
     /// The latent model's training skeletons (its `rigs.json`).
     pub fn latent(dir: Option<&Path>, rigs: &KnownRigs) -> anyhow::Result<Known> {
         let model = model_label(dir, "the built-in latent model");
-        Known::new(model, rigs.rigs.iter().map(|r| (r.name.as_str(), r.joints.as_slice(), r.parents.as_slice(), r.offsets.as_slice())))
+        Ok(Known { reference: rigs.ood_reference()?, model })
     }
 
     /// `skeleton`'s score (None when the model records no skeletons).
     pub fn score(&self, label: &str, skeleton: &Skeleton) -> anyhow::Result<Option<Score>> {
-        Ok(self.reference.score(&Profile::of_skeleton(label, skeleton, NameTable::builtin()?)))
+        Ok(self.reference.score_skeleton(label, skeleton)?)
     }
 
     /// Print `tool`'s warning for `skeleton` (named `label`) on stderr when it is out of range,

@@ -1,11 +1,10 @@
 //! `skel-aug`: skeletal augmentation of a BVH (motion carried over exactly) or a skeleton
 //! document.
 
+use crate::augment::source::Source;
 use crate::augment::{self, RemoveAmount};
 use crate::cli::CommonOpts;
-use crate::document::SkeletonDocument;
-use crate::skeleton::Skeleton;
-use crate::{bvh, io};
+use crate::io;
 use anyhow::{bail, Context};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -79,12 +78,6 @@ pub struct Args {
     pub common: CommonOpts,
 }
 
-/// What came in: the output is of the same kind.
-enum Input {
-    Bvh(bvh::Bvh),
-    Document(Box<SkeletonDocument>),
-}
-
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     let options = options(args)?;
@@ -92,25 +85,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // Output paths first: a bad pattern fails before any work and before any output.
     let outputs = output_paths(args.common.output.as_deref(), count)?;
 
-    let name = io::display_name(&args.input);
-    let bytes = io::read_input(&args.input).with_context(|| format!("cannot read {name}"))?;
-    let input = if crate::cli::load::is_gltf(&args.input, &bytes) {
-        Input::Bvh(crate::cli::load::parse_motion(&bytes, &name, &args.input)?)
-    } else if looks_like_json(&bytes) {
-        let text = std::str::from_utf8(&bytes).map_err(|e| anyhow::anyhow!("{name}: not UTF-8 text: {e}"))?;
-        Input::Document(Box::new(SkeletonDocument::from_json(text).with_context(|| name.clone())?))
-    } else {
-        Input::Bvh(crate::cli::load::parse_motion(&bytes, &name, &args.input)?)
-    };
+    let (name, bytes) = io::read_named(&args.input)?;
+    let input = Source::parse(&bytes, &name, &args.input, &crate::cli::load::gltf_options())?;
     // Every variant is held until all are written (all or nothing); each has its frames.
     crate::budget::check("the variants' text", count as u128 * (bytes.len() as u128 + 64 * args.add as u128), 2)?;
-    if let Input::Bvh(b) = &input {
+    if let Source::Bvh(b) = &input {
         crate::budget::check_motion(&format!("{name}: the augmented motion"), b.frames, b.joints.len() + args.add)?;
     }
-    let skeleton = match &input {
-        Input::Bvh(b) => Skeleton::from_bvh(b),
-        Input::Document(d) => d.skeleton().map_err(|e| anyhow::anyhow!("{name}: {e}"))?,
-    };
+    let skeleton = input.skeleton(&name)?;
 
     let mut warned = BTreeSet::new();
     let mut texts = Vec::with_capacity(outputs.len());
@@ -128,28 +110,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         if args.common.verbose {
             eprint!("skel-aug: {}", plan.describe(&name, &target));
         }
-        let text = match &input {
-            Input::Bvh(b) => {
-                let edited = plan.apply_bvh(b);
-                let format = crate::cli::load::MotionFormat::for_output(out.as_deref(), crate::cli::load::MotionFormat::Bvh);
-                if format == crate::cli::load::MotionFormat::Bvh {
-                    bvh::write_string(&edited).into_bytes()
-                } else {
-                    let skeleton = Skeleton::from_bvh(&edited);
-                    let motion = crate::motion::Motion::from_bvh(&edited, &skeleton);
-                    crate::cli::load::motion_file(&skeleton, &motion, out.as_deref(), format)?
-                }
-            }
-            Input::Document(d) => {
-                let source = format!("{} (skel-aug --seed {} variant {i})", d.source, args.common.seed);
-                let motion = if plan.is_empty() { d.motion.clone() } else { None };
-                let doc = SkeletonDocument::build(&plan.skeleton, motion, &source, d.topology.dmax);
-                let mut json =
-                    if args.pretty { serde_json::to_string_pretty(&doc) } else { serde_json::to_string(&doc) }.context("serialising the skeleton document")?;
-                json.push('\n');
-                json.into_bytes()
-            }
-        };
+        let text = input.variant(&plan, i, args.common.seed, out.as_deref(), args.pretty)?;
         texts.push(text);
     }
     // All variants or none.
@@ -176,23 +137,9 @@ fn output_paths(output: Option<&Path>, count: usize) -> anyhow::Result<Vec<Optio
     }
 }
 
-/// JSON documents start with '{' (after whitespace or a byte-order mark); BVH with HIERARCHY.
-fn looks_like_json(bytes: &[u8]) -> bool {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{')
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn json_is_recognised_by_its_first_character() {
-        assert!(looks_like_json(b"  \n{\"format\": 1}"));
-        assert!(looks_like_json(b"\xEF\xBB\xBF{}"));
-        assert!(!looks_like_json(b"HIERARCHY\n"));
-        assert!(!looks_like_json(b""));
-    }
 
     #[test]
     fn output_patterns() {

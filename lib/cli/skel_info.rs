@@ -1,10 +1,10 @@
 //! `skel-info`: BVH -> skeleton document (JSON) or a readable tree.
 
 use crate::cli::CommonOpts;
-use crate::document::{AnyTopSection, MotionInfo, SkeletonDocument};
-use crate::motion::Motion;
-use crate::skeleton::{topology, Skeleton};
-use crate::{bvh, io};
+use crate::document::of_file::RestPose;
+use crate::document::SkeletonDocument;
+use crate::io;
+use crate::skeleton::topology;
 use anyhow::Context;
 use std::path::PathBuf;
 
@@ -65,26 +65,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let rest_pose = match &args.rest_pose {
         Some(path) => {
-            let name = io::display_name(path);
-            let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
-            let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
-            if parsed.frames == 0 {
-                anyhow::bail!("--rest-pose {name}: the file has no frames (the rest pose is its frame 0)");
-            }
-            let skeleton = Skeleton::from_bvh(&parsed);
-            Some((name, skeleton.clone(), Motion::from_bvh_frames(&parsed, &skeleton, 0..2)))
+            let (name, bytes) = io::read_named(path)?;
+            Some(RestPose::of_bvh(&crate::cli::load::parse_motion(&bytes, &name, path)?, &name)?)
         }
         None => None,
     };
     let mut out = String::new();
     for path in &args.inputs {
-        let name = io::display_name(path);
-        let bytes = io::read_input(path).with_context(|| format!("cannot read {name}"))?;
+        let (name, bytes) = io::read_named(path)?;
         let parsed = crate::cli::load::parse_motion(&bytes, &name, path)?;
-        let skeleton = Skeleton::from_bvh(&parsed);
-        let mut doc = SkeletonDocument::build(&skeleton, MotionInfo::of(&parsed, &skeleton), &name, args.dmax as usize);
-        if !args.no_anytop {
-            doc.anytop = anytop_section(&parsed, &skeleton, &name, rest_pose.as_ref(), args.common.quiet)?;
+        let (doc, no_record) = SkeletonDocument::of_file(&parsed, &name, args.dmax as usize, !args.no_anytop, rest_pose.as_ref())?;
+        if let (Some(e), false) = (no_record, args.common.quiet) {
+            eprintln!("skel-info: {name}: no AnyTop record: {e}");
         }
         match args.format {
             Format::Json => {
@@ -96,35 +88,4 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     }
     Ok(io::write_output(args.common.output.as_deref(), out.as_bytes())?)
-}
-
-/// AnyTop's record for one input: the rest pose is frame 0 of `--rest-pose` when given, else
-/// frame 0 of the input itself (AnyTop's choice when there is no T-pose file), else, for a
-/// file without frames, the OFFSET pose.
-fn anytop_section(
-    parsed: &bvh::Bvh,
-    skeleton: &Skeleton,
-    name: &str,
-    rest_pose: Option<&(String, Skeleton, Motion)>,
-    quiet: bool,
-) -> anyhow::Result<Option<AnyTopSection>> {
-    let motion = Motion::from_bvh(parsed, skeleton);
-    if let Some((file, rest_skeleton, _)) = rest_pose {
-        let same = rest_skeleton.joints.len() == skeleton.joints.len()
-            && rest_skeleton.joints.iter().zip(&skeleton.joints).all(|(a, b)| a.name == b.name && a.parent == b.parent);
-        if !same {
-            anyhow::bail!("--rest-pose {file} has a different skeleton than {name}");
-        }
-    }
-    // A skeleton AnyTop cannot describe (a single joint, bones of zero length) is still a
-    // skeleton: describe it without the record and say why.
-    match AnyTopSection::of_file(skeleton, &motion, name, rest_pose.map(|(file, _, rest)| (file.as_str(), rest))) {
-        Ok(section) => Ok(Some(section)),
-        Err(e) => {
-            if !quiet {
-                eprintln!("skel-info: {name}: no AnyTop record: {e}");
-            }
-            Ok(None)
-        }
-    }
 }

@@ -142,6 +142,12 @@ fn is_plain_x0(w: &crate::diffusion::train::Weighting) -> bool {
 }
 
 impl CheckpointInfo {
+    /// The training skeletons this checkpoint records, as the out-of-distribution score's
+    /// reference (`ood`).
+    pub fn ood_reference(&self) -> Result<crate::ood::Reference, crate::embed::EmbedError> {
+        crate::ood::Reference::from_records(self.skeletons.iter().map(|t| (t.name.as_str(), t.joints.as_slice(), t.parents.as_slice(), t.offsets.as_slice())))
+    }
+
     /// The noise schedule the model was trained with: sampling must use the same one.
     pub fn schedule(&self) -> crate::diffusion::Schedule {
         crate::diffusion::Schedule::cosine_shifted(self.schedule_steps, self.noise_shift)

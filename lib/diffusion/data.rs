@@ -365,6 +365,24 @@ impl TrainSet {
         self.augmented.iter().map(Vec::len).sum()
     }
 
+    /// One line on what the set holds: its skeletons by name, clips, feature frames and
+    /// augmented variants.
+    pub fn summary(&self) -> String {
+        format!(
+            "{} skeletons ({}), {} clips, {} feature frames; {} augmented variants",
+            self.skeletons.len(),
+            self.skeletons.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "),
+            self.skeletons.iter().map(|s| s.clips.len()).sum::<usize>(),
+            self.skeletons.iter().flat_map(|s| &s.clips).map(|c| c.frames).sum::<usize>(),
+            self.variant_count()
+        )
+    }
+
+    /// One line per augmented variant: its name, joints and clips.
+    pub fn variant_lines(&self) -> Vec<String> {
+        self.augmented.iter().flatten().map(|v| format!("variant {}: {} joints, {} clips", v.name, v.skeleton.len(), v.clips.len())).collect()
+    }
+
     /// Draw `batch` crops of at most `frames` feature frames: a skeleton uniformly (each gets
     /// 1/#skeletons, AnyTop's balancing sampler), with `augment_probability` one of its
     /// augmented variants (uniformly) instead, a clip of it uniformly, a crop start uniformly.

@@ -38,6 +38,18 @@ pub enum EditError {
     Mask { got: usize, frames: usize, joints: usize },
     #[error("{0}")]
     Stats(String),
+    /// An option's value that does not hold (the option names itself).
+    #[error("{flag}")]
+    Option {
+        flag: &'static str,
+        #[source]
+        source: Box<EditError>,
+    },
+    #[error("--keep-frames/--keep-joints keep every frame and joint: nothing is left to generate")]
+    KeepsAll,
+    /// A reference clip that cannot be edited on the skeleton being sampled.
+    #[error("{0}")]
+    Reference(String),
 }
 
 /// Which (frame, joint) cells of the output are taken from the reference; all 13 features of a

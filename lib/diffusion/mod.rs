@@ -6,8 +6,11 @@ pub mod condition;
 pub mod data;
 pub mod edit;
 pub mod ema;
+pub mod keep;
+pub mod progress;
 pub mod sample;
 pub mod schedule;
+pub mod start;
 pub mod train;
 pub mod trainer;
 

@@ -6,7 +6,7 @@ use super::schedule::{Sampler, Schedule};
 use super::DiffusionError;
 use crate::nn::{batch_from, BatchItem, Denoiser};
 use crate::repr::anytop::{plant_feet, AnyTopStats};
-use crate::repr::smooth::smooth_features;
+use crate::repr::smooth::{lambda_for_cutoff, smooth_features};
 use crate::repr::Features;
 use crate::rng::gaussian;
 use crate::rng::SplitMix64;
@@ -144,6 +144,28 @@ pub struct PostProcess {
 }
 
 impl PostProcess {
+    /// The post-process of motion at `fps` asked for in physical units: a smoothing cutoff in
+    /// Hz (`smooth_hz`, 0 = none; below half the frame rate), and a blend of `blend_seconds`
+    /// (at most `max_seconds`).
+    pub fn new(smooth_hz: f64, blend_seconds: f64, plant_feet: bool, fps: f64, max_seconds: f64) -> Result<PostProcess, DiffusionError> {
+        let smooth = match smooth_hz {
+            0.0 => None,
+            hz if !hz.is_finite() || hz < 0.0 => {
+                return Err(DiffusionError::Invalid(format!("--smooth must be a cutoff in Hz (>= 0; 0 = no smoothing), found {hz}")));
+            }
+            hz => Some(lambda_for_cutoff(hz, fps).ok_or_else(|| {
+                DiffusionError::Invalid(format!(
+                    "--smooth {hz}: the cutoff must be below half the frame rate ({:.1} Hz at {fps:.1} fps); 0 = no smoothing",
+                    fps / 2.0
+                ))
+            })?),
+        };
+        if !(blend_seconds.is_finite() && blend_seconds >= 0.0 && blend_seconds <= max_seconds) {
+            return Err(DiffusionError::Invalid(format!("--blend must be a duration in seconds (>= 0), found {blend_seconds}")));
+        }
+        Ok(PostProcess { smooth, blend: (blend_seconds * fps).round() as usize, plant_feet })
+    }
+
     /// Apply to one sample. `feet` are the rig's foot joints; `fixed` cells
     /// (`[frame * joints + joint]`, an edit's kept part) keep their values.
     pub fn apply(&self, f: &mut Features, feet: &[usize], fixed: Option<&[bool]>) {

@@ -12,6 +12,7 @@
 
 pub mod correspond;
 pub mod eval;
+pub mod report;
 
 use crate::diffusion::checkpoint::CheckpointInfo;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
@@ -84,6 +85,13 @@ pub struct DiftFeatures {
 }
 
 impl DiftFeatures {
+    /// The features as a little-endian float32 NPY `[tokens, joints, width]`.
+    pub fn to_npy(&self) -> std::io::Result<Vec<u8>> {
+        let mut bytes = Vec::new();
+        crate::io::npy::write_f32_parts(&mut bytes, &[self.tokens, self.joints, self.width], &[self.data.as_slice()])?;
+        Ok(bytes)
+    }
+
     /// Motion frames (tokens minus the rest-pose token).
     pub fn frames(&self) -> usize {
         self.tokens.saturating_sub(1)

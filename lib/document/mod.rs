@@ -7,6 +7,7 @@
 //! Later versions add optional fields (feature statistics, the rest-pose feature row);
 //! readers ignore fields they do not know.
 
+pub mod of_file;
 mod text;
 
 use crate::bvh::Bvh;

@@ -51,6 +51,7 @@
 //! * the example pyramid follows the synthesis's time scale at every level (as in `retarget`),
 //!   so an output longer than the examples has proportionally longer levels.
 
+pub mod clips;
 pub(crate) mod heading;
 #[cfg(test)]
 mod tests;
@@ -88,6 +89,9 @@ pub enum GenmmError {
     KeepShape { what: &'static str, found: usize, expected: usize },
     #[error("{0}")]
     Budget(#[from] crate::budget::BudgetError),
+    /// A reference clip of an edit that does not fit the examples.
+    #[error("{0}")]
+    Reference(String),
     #[error("decoding the result")]
     Decode(#[from] crate::repr::m2m::M2mError),
 }

@@ -28,6 +28,25 @@ pub fn display_name(path: &Path) -> String {
     }
 }
 
+/// An input that could not be read, named as messages name it.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot read {name}")]
+pub struct ReadError {
+    pub name: String,
+    #[source]
+    pub source: io::Error,
+}
+
+/// An input's name for messages (`display_name`) and its bytes (`read_input`): what every tool
+/// does first with a path it is given, with the one message for a failure.
+pub fn read_named(path: &Path) -> Result<(String, Vec<u8>), ReadError> {
+    let name = display_name(path);
+    match read_input(path) {
+        Ok(bytes) => Ok((name, bytes)),
+        Err(source) => Err(ReadError { name, source }),
+    }
+}
+
 /// Write `bytes` to `path` (see `output`), or to stdout when `path` is `-` or `None`.
 pub fn write_output(path: Option<&Path>, bytes: &[u8]) -> Result<(), OutputError> {
     output::write_one(path, bytes)

@@ -6,6 +6,7 @@
 //! Every function returns a defined value or a [`MetricError`]; none panics or returns NaN on
 //! finite input, and inputs are checked for non-finite values first.
 
+pub mod checks;
 pub mod fid;
 pub mod generation;
 pub mod geometric;

@@ -32,6 +32,12 @@ pub enum ReportError {
         #[source]
         source: AnyTopError,
     },
+    #[error("{name}: cannot build an AnyTop rig")]
+    Rig {
+        name: String,
+        #[source]
+        source: AnyTopError,
+    },
     #[error(transparent)]
     Json(#[from] serde_json::Error),
     /// Clips that cannot be compared, or a report that is not one, said in one sentence.

@@ -8,6 +8,7 @@
 pub mod clip;
 pub mod ik;
 pub mod rotation;
+pub mod write;
 
 pub use clip::{Clip, ClipError};
 

@@ -66,6 +66,17 @@ impl JointLabels {
 }
 
 impl FrameLabels {
+    /// Segments are frames of the motions drawn (`longest` frames at most): a segment that
+    /// ends past them belongs to a label file of another motion (`file` names it).
+    pub fn check_fits(&self, longest: usize, file: &str) -> Result<(), RenderError> {
+        if let FrameLabels::Segments(segments) = self {
+            if let Some((i, (_, end, _))) = segments.iter().enumerate().find(|(_, (_, end, _))| *end > longest) {
+                return Err(RenderError::Invalid(format!("{file}: segment {i} ends at frame {end}, but the longest motion has {longest} frames")));
+            }
+        }
+        Ok(())
+    }
+
     /// Parse a frame label file (`file` names it in errors).
     pub fn from_json(text: &str, file: &str) -> Result<FrameLabels, RenderError> {
         let value: Value = serde_json::from_str(text).map_err(|e| RenderError::Invalid(format!("{file}: not JSON: {e}")))?;

@@ -23,6 +23,7 @@
 //!
 //! Frame rates are the caller's business: `resample` brings the source to the examples' rate.
 
+pub mod clips;
 mod describe;
 mod features;
 pub mod settings;

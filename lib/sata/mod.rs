@@ -96,6 +96,14 @@ pub const FEATURE_DIMS: usize = 13;
 pub const INPUT_DIMS: usize = FEATURE_DIMS + 6;
 
 impl SataConfig {
+    /// This config with inference windows (and training crops) of `window` frames; the overlap
+    /// shrinks, if needed, to under half a window, so windows still advance.
+    pub fn with_window(mut self, window: usize) -> SataConfig {
+        self.window = window;
+        self.overlap = self.overlap.min(window.saturating_sub(1) / 2);
+        self
+    }
+
     /// The paper's base model (§4.1.1): width 256, 3 + 3 blocks, 4 heads, ff 512, latent 128,
     /// windows of 64 frames overlapping by 16.
     pub fn paper() -> SataConfig {

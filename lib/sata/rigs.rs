@@ -75,6 +75,12 @@ pub struct KnownRigs {
 }
 
 impl KnownRigs {
+    /// The skeletons these rigs were trained on, as the out-of-distribution score's reference
+    /// (`ood`).
+    pub fn ood_reference(&self) -> Result<crate::ood::Reference, crate::embed::EmbedError> {
+        crate::ood::Reference::from_records(self.rigs.iter().map(|r| (r.name.as_str(), r.joints.as_slice(), r.parents.as_slice(), r.offsets.as_slice())))
+    }
+
     /// The rigs of a training set's skeletons (not of its augmented variants: a variant met at
     /// inference is a new skeleton to the user too).
     pub fn of_set(set: &TrainSet) -> KnownRigs {

@@ -8,8 +8,10 @@ use super::{SegmentError, SegmentOptions, Segmentation};
 use crate::diffusion::checkpoint::FrozenDenoiser;
 use crate::dift::{self, DiftError, DiftOptions};
 use crate::document::AnyTopSection;
-use crate::motion::Motion;
-use crate::repr::anytop::AnyTopError;
+use crate::input::{InputError, SkeletonFile};
+use crate::motion::{Clip, Motion};
+use crate::repr::anytop::{AnyTopError, FEATURE_DIMS};
+use crate::repr::batch::split_samples;
 use crate::repr::Features as ReprFeatures;
 use crate::skeleton::Skeleton;
 
@@ -40,6 +42,9 @@ pub enum SegmentInputError {
     },
     #[error("{0}")]
     Invalid(String),
+    /// The skeleton file given with the motion.
+    #[error(transparent)]
+    Skeleton(#[from] InputError),
 }
 
 /// A motion to segment, as its AnyTop features: what every feature provider gets.
@@ -85,6 +90,64 @@ impl Input {
         let encoded = section.rig.encode(&skeleton, &motion).map_err(|e| SegmentInputError::Invalid(format!("{name}: {e}")))?;
         let frame_time = usable_frame_time(motion.frame_time);
         Ok(Input { name, frames: motion.frames, frame_time, anytop: encoded.features, skeleton: Some((skeleton, section)) })
+    }
+}
+
+impl Input {
+    /// A motion file's clip, encoded with the rig of `skeleton` when one is given (so that the
+    /// features are those `mo-encode --skeleton` makes with it), else with its own.
+    pub fn from_clip(clip: Clip, skeleton: Option<SkeletonFile>) -> Result<Input, SegmentInputError> {
+        let Clip { name, skeleton: own, motion } = clip;
+        match skeleton {
+            Some(file) => {
+                if let Some(diff) = file.skeleton.first_difference(&own) {
+                    return Err(SegmentInputError::Invalid(format!("{name} is not on the skeleton of {}: {diff}", file.name)));
+                }
+                let section = file.record()?;
+                Input::with_record(name, own, motion, section)
+            }
+            None => Input::from_motion(name, own, motion),
+        }
+    }
+
+    /// One motion's AnyTop features from an NPY (`[frames, joints, 13]`, as `mo-encode` writes
+    /// them), on `skeleton` when one is given: its record, and its frame time when it is a
+    /// motion file (else AnyTop's 1/30 s).
+    pub fn from_npy(name: String, array: crate::io::npy::NpyArray, skeleton: Option<SkeletonFile>) -> Result<Input, SegmentInputError> {
+        let (mut samples, batch) = split_samples(array, &name).map_err(SegmentInputError::Invalid)?;
+        if batch {
+            return Err(SegmentInputError::Invalid(format!(
+                "{name}: a batch of {} samples; mo-segment takes one motion (a [frames, joints, 13] array)",
+                samples.len()
+            )));
+        }
+        let anytop = samples.remove(0);
+        if anytop.dims != FEATURE_DIMS {
+            return Err(SegmentInputError::Invalid(format!(
+                "{name}: expected AnyTop features with {FEATURE_DIMS} values per joint (mo-encode's default), found {}",
+                anytop.dims
+            )));
+        }
+        if anytop.frames == 0 {
+            return Err(SegmentInputError::Invalid(format!("{name}: the features have no frames")));
+        }
+        let (skeleton, frame_time) = match skeleton {
+            Some(file) => {
+                if anytop.joints != file.skeleton.len() {
+                    return Err(SegmentInputError::Invalid(format!(
+                        "{name}: the features have {} joints but the skeleton {} has {}",
+                        anytop.joints,
+                        file.name,
+                        file.skeleton.len()
+                    )));
+                }
+                let frame_time = file.motion.as_ref().map_or(1.0 / 30.0, |m| usable_frame_time(m.frame_time));
+                let section = file.record()?;
+                (Some((file.skeleton, section)), frame_time)
+            }
+            None => (None, 1.0 / 30.0),
+        };
+        Ok(Input { name, frames: anytop.frames + 1, frame_time, anytop, skeleton })
     }
 }
 

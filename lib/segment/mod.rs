@@ -30,6 +30,7 @@
 pub mod input;
 mod kmeans;
 mod pca;
+pub mod report;
 
 pub use kmeans::{kmeans, KMeans, MAX_ITERATIONS};
 pub use pca::{pca, Pca};
