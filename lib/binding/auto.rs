@@ -4,7 +4,8 @@
 //!
 //! Motion2Motion's appendix A binds the few most similar bone chains (a 6.1% binding rate).
 //! Our binder binds every confident pair instead (`correspond::bindable`: both joints move a
-//! bone, same side, same limb pair, neither joint has a better partner, no feet): a binding that ties
+//! bone, same side, same limb pair, neither joint has a better partner, no toes; and each
+//! matched limb tied at its first joint and its end: foot, hand, tip): a binding that ties
 //! each leg to its leg and the spine to the spine is what a person writes by hand, and on
 //! real rigs the few-pairs binding left limbs to chance (issue 24). `rate` stays as a limit
 //! for those who want the paper's setting. When fewer than `min_pairs` pairs are confident,
@@ -147,10 +148,13 @@ mod tests {
         let body = Body { skeleton: &s, rest: &rest };
         let few = auto_bind(&body, &body, &AutoOptions { rate: Some(0.061), ..AutoOptions::default() }).unwrap();
         let all = auto_bind(&body, &body, &AutoOptions::default()).unwrap();
-        // Unlimited: every joint that moves a bone binds to itself, but feet.
+        // Unlimited: every joint that moves a bone (a leaf with an End Site too) binds to
+        // itself, but toes (feet below the top of their foot).
         let children = s.children();
         let feet = crate::skeleton::roles::feet(&s).0;
-        assert_eq!(all.len(), (1..s.len()).filter(|&j| !children[j].is_empty() && !feet.contains(&j)).count());
+        let toe = |j: usize| feet.contains(&j) && s.joints[j].parent.is_some_and(|p| feet.contains(&p));
+        let moves = |j: usize| !children[j].is_empty() || !s.joints[j].end_sites.is_empty();
+        assert_eq!(all.len(), (1..s.len()).filter(|&j| moves(j) && !toe(j)).count());
         assert_eq!(few.len(), pair_count(0.061, s.len(), s.len(), 4));
         assert_eq!(auto_bind(&body, &body, &AutoOptions { rate: Some(0.0), ..AutoOptions::default() }).unwrap_err(), AutoError::Rate(0.0));
         let short = Body { skeleton: &s, rest: &rest[..2] };

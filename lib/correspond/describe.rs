@@ -45,6 +45,16 @@ pub struct Described {
     /// Feet and toes (`roles::feet`: AnyTop's foot words and what hangs below them, else the
     /// lowest joints of the rest pose).
     pub foot: Vec<bool>,
+    /// Toes and digits: feet below the top of their foot (a foot joint whose parent is a foot).
+    pub toe: Vec<bool>,
+    /// The joint moves a bone: it has a child joint or an End Site (BVH's mark of a bone's end;
+    /// a head's End Site may sit at the joint itself, yet the head's rotation is animated).
+    pub moves: Vec<bool>,
+    /// The first joint of the joint's limb (`None` on the midline).
+    pub base: Vec<Option<usize>>,
+    /// Where each limb base sits along the body axis (larger is further front or up; 0 for
+    /// joints that are not limb bases): orders limbs of one side and class front to back.
+    pub forward: Vec<f64>,
     /// Some joint has a side.
     pub has_sides: bool,
     /// Sides (and limb pairs) come from the names; otherwise from the rest pose.
@@ -131,19 +141,27 @@ pub fn describe(skeleton: &Skeleton, rest: &[DVec3], use_names: bool, roles: Rol
             .collect();
     let bases: Vec<usize> = (0..n).filter(|&j| base[j] == j).collect();
     let limb_keys: &[NameKey] = if roles == Roles::Names { &keys } else { &[] };
-    let class_of_base = limb_classes(&bases, &base, limb_keys, &side, &place, n);
+    let axis = body_axis(&side, &place);
+    let class_of_base = limb_classes(&bases, &base, limb_keys, &place, axis, n);
+    let mut forward = vec![0.0; n];
+    for &b in &bases {
+        forward[b] = place[b].dot(axis.unwrap_or(DVec3::new(0.0, 1.0, 1.0).normalize()));
+    }
     let limb = (0..n).map(|j| if base[j] == usize::MAX { Limb::Centre } else { class_of_base[base[j]] }).collect();
     let leaf = children.iter().map(Vec::is_empty).collect();
     let mut foot = vec![false; n];
     for f in roles::feet(skeleton).0 {
         foot[f] = true;
     }
-    Described { keys, side, limb, along, place, direction, signature, parents, leaf, foot, has_sides, named_sides }
+    let toe = (0..n).map(|j| foot[j] && parents[j].is_some_and(|p| foot[p])).collect();
+    let moves = (0..n).map(|j| !children[j].is_empty() || !skeleton.joints[j].end_sites.is_empty()).collect();
+    let base = base.iter().map(|&b| (b != usize::MAX).then_some(b)).collect();
+    Described { keys, side, limb, along, place, direction, signature, parents, leaf, foot, toe, moves, base, forward, has_sides, named_sides }
 }
 
 /// Front or hind for every limb base (indexed by joint): by names when the names tell the
 /// limb pairs apart, else by the rest pose.
-fn limb_classes(bases: &[usize], base: &[usize], keys: &[NameKey], side: &[Side], place: &[DVec3], n: usize) -> Vec<Limb> {
+fn limb_classes(bases: &[usize], base: &[usize], keys: &[NameKey], place: &[DVec3], axis: Option<DVec3>, n: usize) -> Vec<Limb> {
     let mut out = vec![Limb::Unknown; n];
     // Votes of every joint's words in each limb.
     let mut votes = vec![(0usize, 0usize); n];
@@ -170,10 +188,8 @@ fn limb_classes(bases: &[usize], base: &[usize], keys: &[NameKey], side: &[Side]
         }
         return out;
     }
-    // Rest pose: the body axis is the main direction of the centre joints.
-    let centre: Vec<DVec3> = (0..n).filter(|&j| side[j] == Side::Centre).map(|j| place[j]).collect();
-    let Some(axis) = main_direction(&centre) else { return out };
-    let axis = if axis.dot(DVec3::new(0.0, 1.0, 1.0)) < 0.0 { -axis } else { axis };
+    // Rest pose: which end of the body axis the limb hangs from.
+    let Some(axis) = axis else { return out };
     let proj: Vec<f64> = bases.iter().map(|&b| place[b].dot(axis)).collect();
     let (lo, hi) = proj.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     if !(hi - lo > 0.05) {
@@ -184,6 +200,14 @@ fn limb_classes(bases: &[usize], base: &[usize], keys: &[NameKey], side: &[Side]
         out[b] = if proj[k] > mid { Limb::Front } else { Limb::Hind };
     }
     out
+}
+
+/// The body axis: the main direction of the centre joints, oriented up-or-forward (the rest
+/// pose faces +z); `None` when the centre joints do not spread.
+fn body_axis(side: &[Side], place: &[DVec3]) -> Option<DVec3> {
+    let centre: Vec<DVec3> = (0..side.len()).filter(|&j| side[j] == Side::Centre).map(|j| place[j]).collect();
+    let axis = main_direction(&centre)?;
+    Some(if axis.dot(DVec3::new(0.0, 1.0, 1.0)) < 0.0 { -axis } else { axis })
 }
 
 /// The direction of largest spread of `points` (power iteration on the 3x3 covariance);

@@ -258,11 +258,12 @@ pub fn per_target(scores: &Scores, pairs: &[Pair]) -> Vec<(usize, Option<(Pair, 
         .collect()
 }
 
-/// Pairs that may be bound: both joints move a bone (not the root, not leaves), the same side
-/// and the same limb pair (or both on the midline). Highest score first.
+/// Pairs that may be bound: both joints move a bone (not the root; a leaf only with an End
+/// Site, as a head or a hand tip has), the same side and the same limb pair (or
+/// both on the midline). Highest score first.
 pub fn compatible(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
     let (a, b) = (&scores.source, &scores.target);
-    let inner = |d: &Described, j: usize| d.parents[j].is_some() && !d.leaf[j];
+    let inner = |d: &Described, j: usize| d.parents[j].is_some() && d.moves[j];
     let mut out: Vec<Pair> = pairs
         .iter()
         .filter(|p| inner(a, p.source) && inner(b, p.target))
@@ -270,18 +271,136 @@ pub fn compatible(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
         .filter(|p| a.limb[p.source] == b.limb[p.target])
         .cloned()
         .collect();
-    out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.source.cmp(&y.source)).then(x.target.cmp(&y.target)));
+    sort_pairs(&mut out);
     out
 }
 
-/// The compatible pairs worth binding: confident (neither joint had a better partner,
-/// `margin` >= 0, and the evidence is positive overall) and not feet or toes. Feet stay with
-/// the examples: a foot's rotation is mostly its contact with the ground, which the target's
-/// own clips know and another species' foot does not; binding them lowered frequency
-/// alignment on Flamingo -> Monkey from 0.95 to 0.85 (docs/retarget-results.md).
+fn sort_pairs(pairs: &mut [Pair]) {
+    pairs.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.source.cmp(&y.source)).then(x.target.cmp(&y.target)));
+}
+
+/// The compatible pairs worth binding, and each matched limb tied at both ends, as a person
+/// binds by hand:
+///
+/// * limbs are matched first (`match_limbs`: per side and limb pair, in order along the body);
+///   a pair that joins two limbs that are not matched is dropped;
+/// * a joint pair is bound when it is confident (neither joint had a better partner,
+///   `margin` >= 0, and the evidence is positive overall) and `end_ok`;
+/// * every matched front or hind limb's first joint binds to the other's first joint, and its
+///   end effector (the hand, foot or tip the limb ends in) to the other's, when `end_ok` and
+///   neither joint is bound already.
+///
+/// Ends were once never bound (a rule from Flamingo -> Monkey alone); the hand bindings of
+/// the corpus pairs tie exactly them, and without them the automatic binding's frequency
+/// alignment fell short of a hand binding's (docs/retarget-results.md).
 pub fn bindable(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
     let (a, b) = (&scores.source, &scores.target);
-    compatible(scores, pairs).into_iter().filter(|p| p.margin >= 0.0 && p.score > 0.0 && !a.foot[p.source] && !b.foot[p.target]).collect()
+    let limbs = match_limbs(a, b);
+    let consistent = |p: &Pair| match (a.base[p.source], b.base[p.target]) {
+        (Some(x), Some(y)) => limbs.contains(&(x, y)),
+        _ => true,
+    };
+    let mut out: Vec<Pair> =
+        compatible(scores, pairs).into_iter().filter(|p| p.margin >= 0.0 && p.score > 0.0 && consistent(p) && end_ok(a, p.source, b, p.target)).collect();
+    for &(x, y) in &limbs {
+        if !matches!(a.limb[x], Limb::Front | Limb::Hind) {
+            continue;
+        }
+        for (s, t) in [(x, y), (limb_end(a, x), limb_end(b, y))] {
+            if !(a.moves[s] && b.moves[t] && end_ok(a, s, b, t)) || out.iter().any(|p| p.source == s || p.target == t) {
+                continue;
+            }
+            if let Some(score) = scores.score[s][t] {
+                out.push(Pair { source: s, target: t, score, margin: 0.0, confidence: 0.5 });
+            }
+        }
+    }
+    sort_pairs(&mut out);
+    out
+}
+
+/// Whether joint `s` of `a` and `t` of `b` may be bound as far as limb ends go:
+///
+/// * never a toe (a foot joint below the top of its foot): its rotation is mostly its
+///   contact with the ground, which the target's own clips know and another species' toe
+///   does not;
+/// * a foot with toes below it only where both limbs have as many joints above it: which joint
+///   is the ankle is ambiguous otherwise (a bird's `Foot` is the base of its toes, its ankle is
+///   the `HorseLink`; binding a flamingo's and a chicken's `Foot` to a monkey's lowered frequency
+///   alignment from 0.95 to 0.87 and from 0.70 to 0.51);
+/// * a leaf only on the midline (a head, a tail tip) or at the end of a front or hind limb (a
+///   hand, a foot), not at the end of a limb of unknown kind (ears, eyelids, a beard).
+fn end_ok(a: &Described, s: usize, b: &Described, t: usize) -> bool {
+    if a.toe[s] || b.toe[t] {
+        return false;
+    }
+    let toes_below = |d: &Described, j: usize| (0..d.parents.len()).any(|c| d.parents[c] == Some(j) && d.toe[c]);
+    if toes_below(a, s) || toes_below(b, t) {
+        match (a.base[s], b.base[t]) {
+            (Some(x), Some(y)) if depth_below(a, s, x) == depth_below(b, t, y) => {}
+            (None, None) => {}
+            _ => return false,
+        }
+    }
+    let leaf_ok = |d: &Described, j: usize| !d.leaf[j] || matches!(d.limb[j], Limb::Centre | Limb::Front | Limb::Hind);
+    leaf_ok(a, s) && leaf_ok(b, t)
+}
+
+/// Joints from `ancestor` down to `j`.
+fn depth_below(d: &Described, mut j: usize, ancestor: usize) -> usize {
+    let mut n = 0;
+    while j != ancestor {
+        match d.parents[j] {
+            Some(p) => {
+                j = p;
+                n += 1;
+            }
+            None => break,
+        }
+    }
+    n
+}
+
+/// Limbs of `a` and `b` (by their first joints) that correspond: the same side and the same
+/// limb pair, matched in order along the body axis, front limbs from the front and hind limbs
+/// from the back (a dog's hind legs with a crab's rearmost legs); limbs whose pair is unknown
+/// only when both skeletons have as many of them. Limbs left over stay unmatched.
+pub fn match_limbs(a: &Described, b: &Described) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    for side in [Side::Left, Side::Right] {
+        for class in [Limb::Front, Limb::Hind, Limb::Unknown] {
+            let ordered = |d: &Described| {
+                let mut v: Vec<usize> = (0..d.base.len()).filter(|&j| d.base[j] == Some(j) && d.side[j] == side && d.limb[j] == class).collect();
+                // Front first; hind limbs back first.
+                v.sort_by(|x, y| d.forward[*y].total_cmp(&d.forward[*x]).then(x.cmp(y)));
+                if class == Limb::Hind {
+                    v.reverse();
+                }
+                v
+            };
+            let (x, y) = (ordered(a), ordered(b));
+            if class == Limb::Unknown && x.len() != y.len() {
+                continue;
+            }
+            out.extend(x.into_iter().zip(y));
+        }
+    }
+    out
+}
+
+/// The end effector of the limb starting at `base`: down its chain (children that move a bone
+/// and are not toes) to a foot, to where the chain branches (a hand with its fingers) or to
+/// its tip.
+fn limb_end(d: &Described, base: usize) -> usize {
+    let n = d.parents.len();
+    let mut cur = base;
+    loop {
+        let next: Vec<usize> = (0..n).filter(|&c| d.parents[c] == Some(cur) && d.moves[c] && !d.toe[c]).collect();
+        if d.foot[cur] || next.len() != 1 {
+            return cur;
+        }
+        cur = next[0];
+    }
 }
 
 #[cfg(test)]

@@ -120,3 +120,35 @@ fn skel_aug_variants_bind_back_to_their_original() {
     // this guards against regressions of the geometric part.
     assert!(geometry.0 * 10 >= geometry.1 * 8, "geometry only: {}/{}", geometry.0, geometry.1);
 }
+
+#[test]
+fn limb_ends_bind_to_their_own_limb_ends() {
+    let Some(data) = common::shared_data("limb_ends_bind_to_their_own_limb_ends") else { return };
+    let bvh = data.join("bvh");
+    let has =
+        |sa: &Skeleton, sb: &Skeleton, pairs: &[Choice], s: &str, t: &str| pairs.iter().any(|c| sa.joints[c.source].name == s && sb.joints[c.target].name == t);
+    // Human -> dog: hands, feet and head to the joints of the same name.
+    let (sa, sb, pairs) = bind(&bvh.join("lafan1/walk4_subject1.bvh"), &bvh.join("dog_mann/Dog/D1_007_KAN01_001.bvh"), &AutoOptions::default());
+    report("LAFAN1 -> Dog", &sa, &sb, &pairs, |c| sa.joints[c.source].name == sb.joints[c.target].name);
+    for end in ["LeftFoot", "RightFoot", "LeftHand", "RightHand", "Head"] {
+        assert!(has(&sa, &sb, &pairs, end, end), "LAFAN1 -> Dog: {end} is not bound to {end}");
+    }
+    // CMU -> Xia: CMU's ankle is Xia's foot (the same place in one tree); toes stay unbound.
+    let (sa, sb, pairs) = bind(&bvh.join("cmu_bvh11/131_01.bvh"), &bvh.join("xia_dme/neutral_01_000.bvh"), &AutoOptions::default());
+    assert!(has(&sa, &sb, &pairs, "LeftAnkle", "LeftFoot") && has(&sa, &sb, &pairs, "RightAnkle", "RightFoot"), "CMU -> Xia: ankles");
+    assert!(!pairs.iter().any(|c| sb.joints[c.target].name.contains("ToeBase")), "CMU -> Xia: a toe is bound");
+    // Dog -> crab: the hind feet to the tips of the crab's rearmost legs, the fore feet to the
+    // claws' tips.
+    let (sa, sb, pairs) = bind(&bvh.join("dog_mann/Dog/D1_007_KAN01_001.bvh"), &bvh.join("ganimator/Crab/Crab-dance-long.bvh"), &AutoOptions::default());
+    report("Dog -> Crab", &sa, &sb, &pairs, |_| true);
+    assert!(has(&sa, &sb, &pairs, "LeftFoot", "DEF_BN_Leg_L_15_end") && has(&sa, &sb, &pairs, "RightFoot", "DEF_BN_Leg_R_15_end"), "Dog -> Crab: hind feet");
+    assert!(has(&sa, &sb, &pairs, "LeftHand", "DEF_BN_Arm_L_03_end") && has(&sa, &sb, &pairs, "RightHand", "DEF_BN_Arm_R_03_end"), "Dog -> Crab: fore feet");
+    // Flamingo -> Monkey: a bird's Foot is the base of its toes, a monkey's its ankle; the legs
+    // differ in length above them, so neither Foot is bound.
+    let fm = data.join("bvh/truebones_motion2motion");
+    let (sa, sb, pairs) = bind(&fm.join("Flamingo/Flamingo_Walk.bvh"), &fm.join("Monkey/__Walk.bvh"), &AutoOptions::default());
+    assert!(
+        !pairs.iter().any(|c| sa.joints[c.source].name.contains("_Foot") || sb.joints[c.target].name.contains("_Foot")),
+        "Flamingo -> Monkey: a Foot is bound"
+    );
+}
