@@ -35,17 +35,24 @@
 //!   (Motion2Motion's reference) the zoo walks cover less (47-75% calibrated coverage); random
 //!   segments with arbitrary seams make the matching re-phase the gait at every seam (bursts of
 //!   speed, energy ratio up to 1.3); jumps between similar places keep it nearer 1;
-//! * the coarsest level is twice GenMM's (10 patches of the longest example, not 5) and the walk
-//!   runs on 4 patches before it looks for a jump (`Settings::default`): with GenMM's 5 the zoo's
-//!   run and turn clips are rarely reached or are matched into the walk at the finer levels
-//!   (energy ratio 0.6-0.7 on the zoo quadruped and biped);
-//! * the walk keeps each clip near its share of the examples: at a clip's end it jumps into
-//!   another clip when it can, and jumps are drawn weighted by how far their clip is behind its
-//!   share (`balanced`). Drawn uniformly, an idle clip (whose end looks most like its own
-//!   middle) held the walk for the rest of the sample: energy 0.77 / 0.72 on the zoo quadruped
-//!   and biped and 0.66 on a real chicken's three clips (walk, egg laying, idle pecking), now
-//!   0.90 / 0.79 / 0.97 (`tools/eval_generation.py --model genmm=examples -n 8 --frames 200
-//!   --seed 7`; over 40 samples at seed 100: 0.79 / 0.84 / 0.64 before, 0.89 / 0.90 / 0.93);
+//! * the coarsest level is twice GenMM's (10 patches, not 5) of the median example, not the
+//!   longest, and the walk runs on 4 patches before it looks for a jump (`Settings::default`):
+//!   with GenMM's 5 the zoo's run and turn clips are rarely reached or are matched into the walk
+//!   at the finer levels (energy ratio 0.6-0.7 on the zoo quadruped and biped). Measured on the
+//!   longest, three dog_mann clips of 1531 (standing), 593 and 155 (running) frames at 60 fps
+//!   were squeezed 14 times, the run to a single coarse patch, and the samples stood (energy
+//!   ratio 0.13; 0.42 with the equal shares below, 0.70 with both);
+//! * the walk gives every clip an equal share, however long it is (as the metrics weigh the
+//!   clips, and as a user who brings a long idle and a short run expects to see both): it starts
+//!   in a clip drawn uniformly, at a clip's end it jumps into another clip when it can, and
+//!   jumps are drawn weighted by how far their clip is behind its share (`balanced`). Drawn
+//!   uniformly, an idle clip (whose end looks most like its own middle) held the walk for the
+//!   rest of the sample: energy 0.77 / 0.72 on the zoo quadruped and biped and 0.66 on a real
+//!   chicken's three clips (walk, egg laying, idle pecking). Over 40 samples
+//!   (`tools/eval_generation.py --model genmm=examples -n 40 --frames 200 --seed 100`; zoo
+//!   quadruped / biped / dragon, chicken's three, the dog's three): with uniform jumps 0.79 /
+//!   0.84 / 0.86 / 0.64 (dog not measured); with shares by length 0.89 / 0.90 / 0.99 / 0.93
+//!   (dog 0.13 over 8 samples at seed 7); now 0.88 / 0.84 / 0.84 / 0.96 / 0.70;
 //! * the root's heading is a turning rate, so a stretch that turned a little can follow one that
 //!   did not without the body snapping round;
 //! * the example pyramid follows the synthesis's time scale at every level (as in `retarget`),
@@ -105,8 +112,8 @@ pub struct Settings {
     pub steps: usize,
     /// Length ratio between consecutive pyramid levels (GenMM: 0.75).
     pub pyramid: f64,
-    /// The coarsest level holds about `coarse_patches * patch` frames of the longest example
-    /// (GenMM: '5x_patchsize'; we use 10, see `Default`).
+    /// The coarsest level holds about `coarse_patches * patch` frames of the median example
+    /// (GenMM: '5x_patchsize' of the longest; we use 10 of the median, see `Default`).
     pub coarse_patches: f64,
     /// Completeness normalisation (GenMM's alpha, 0.01): each example patch's distances are
     /// divided by this plus its distance to its closest query patch. `None`: plain nearest
@@ -251,7 +258,12 @@ impl<'a> Plan<'a> {
         let frames = settings.frames.unwrap_or(longest);
         let mut notes = Vec::new();
         let patch = pyramid::fit_patch(settings.patch, frames, &examples.iter().map(|e| e.frames).collect::<Vec<_>>(), &mut notes);
-        let lengths = pyramid::output_levels(frames, longest, patch, settings.coarse_patches, settings.pyramid);
+        // The pyramid's scale from the median clip that has a patch, not the longest: one long
+        // clip beside short ones squeezed them to a patch or two at the coarsest level.
+        let mut by_length: Vec<usize> = examples.iter().map(|e| e.frames).filter(|&f| f >= patch).collect();
+        by_length.sort_unstable();
+        let median = by_length.get(by_length.len() / 2).copied().unwrap_or(longest);
+        let lengths = pyramid::output_levels(frames, median, patch, settings.coarse_patches, settings.pyramid);
         let scale = channels::feature_scale(skeleton);
         let width = channels::rotation_width(skeleton.len()) + 1;
         // The banks of every level are kept for all seeds: each holds its clips twice (weighted
@@ -421,8 +433,8 @@ fn arrangement(clips: &[Channels], weights: &[f32], len: usize, patch: usize, se
     let mut placed = vec![0usize; clips.len()];
     while choice.len() < queries {
         let (k, b) = match choice.last() {
-            Some(&last) => transition(clips, weights, &starts, &placed, last, patch, &mut rng).unwrap_or_else(|| random_patch(&starts, total, &mut rng)),
-            None => random_patch(&starts, total, &mut rng),
+            Some(&last) => transition(clips, weights, &starts, &placed, last, patch, &mut rng).unwrap_or_else(|| random_patch(&starts, &mut rng)),
+            None => random_patch(&starts, &mut rng),
         };
         // The segment runs on from that patch, up to `segment` patches or the clip's end.
         let run = segment.min(starts[k] - b).min(queries - choice.len());
@@ -432,16 +444,12 @@ fn arrangement(clips: &[Channels], weights: &[f32], len: usize, patch: usize, se
     nn::blend(&choice, clips, len, patch)
 }
 
-/// A patch uniformly among all of them: its clip and first frame.
-fn random_patch(starts: &[usize], total: usize, rng: &mut SplitMix64) -> (usize, usize) {
-    let mut r = rng.below(total);
-    for (k, &n) in starts.iter().enumerate() {
-        if r < n {
-            return (k, r);
-        }
-        r -= n;
-    }
-    (0, 0)
+/// A clip drawn uniformly among those with a patch, then a patch uniformly within it: its clip
+/// and first frame. Each clip counts the same however long it is (see `balanced`).
+fn random_patch(starts: &[usize], rng: &mut SplitMix64) -> (usize, usize) {
+    let usable: Vec<usize> = (0..starts.len()).filter(|&k| starts[k] > 0).collect();
+    let k = usable[rng.below(usable.len())];
+    (k, rng.below(starts[k]))
 }
 
 /// Squared difference of the patches of `a` at frame `i` and of `b` at frame `j`.
@@ -520,18 +528,16 @@ fn transition(
 }
 
 /// One of the candidate jumps `(cost, clip, frame)`, drawn with each weighed by how far its
-/// clip is behind its share: the clip's share of the examples' patches over its share of the
-/// walk so far. Drawn uniformly, the walk drifted toward clips whose poses resemble each
+/// clip is behind its share: an equal share of the clips over its share of the walk so far. Drawn uniformly, the walk drifted toward clips whose poses resemble each
 /// other's (an idle, a stop), where most good jumps lead, and the zoo's samples moved at
 /// 0.72-0.77 of their clips' energy; with one clip every weight is equal.
 fn balanced(candidates: &[&(f32, usize, usize)], starts: &[usize], placed: &[usize], rng: &mut SplitMix64) -> usize {
-    let total = starts.iter().sum::<usize>().max(1) as f64;
     let walked = placed.iter().sum::<usize>() as f64;
-    let clips = starts.len().max(1) as f64;
+    let clips = starts.iter().filter(|&&n| n > 0).count().max(1) as f64;
     let weight: Vec<f64> = candidates
         .iter()
         .map(|e| {
-            let share = starts[e.1] as f64 / total;
+            let share = 1.0 / clips;
             // Laplace-smoothed share of the walk, so an unvisited clip is not infinitely behind.
             let walked_share = (placed[e.1] as f64 + 1.0) / (walked + clips);
             share / walked_share

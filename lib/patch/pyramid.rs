@@ -29,11 +29,6 @@ pub(crate) fn lengths(len: usize, ratio: f64, factor: f64) -> Vec<usize> {
     out
 }
 
-/// Output lengths of the levels for an output of `frames` frames, examples at most
-/// `longest_example` frames long, patch `patch`: the reference's rule (the coarsest example
-/// level holds about `coarse_patches * patch` frames), minus the coarse levels shorter than a
-/// patch. The reference keeps those and crashes when the target is more than ~5x longer than
-/// the source.
 /// The patch length both syntheses use: `requested`, no longer than the output (`frames`) or
 /// the longest example clip, and at least 1. Notes when it had to shrink, and for every example
 /// clip shorter than the patch (such a clip has no patch to match and is not used).
@@ -49,8 +44,13 @@ pub(crate) fn fit_patch(requested: usize, frames: usize, example_frames: &[usize
     patch
 }
 
-pub(crate) fn output_levels(frames: usize, longest_example: usize, patch: usize, coarse_patches: f64, factor: f64) -> Vec<usize> {
-    let ratio = (coarse_patches * patch as f64 / longest_example.max(1) as f64).min(1.0);
+/// Output lengths of the levels for an output of `frames` frames, patch `patch`: the
+/// reference's rule (the coarsest level of an example `example_frames` long holds about
+/// `coarse_patches * patch` frames; the reference and `retarget` pass the longest example,
+/// `genmm` the median), minus the coarse levels shorter than a patch. The reference keeps those
+/// and crashes when the target is more than ~5x longer than the source.
+pub(crate) fn output_levels(frames: usize, example_frames: usize, patch: usize, coarse_patches: f64, factor: f64) -> Vec<usize> {
+    let ratio = (coarse_patches * patch as f64 / example_frames.max(1) as f64).min(1.0);
     let mut levels: Vec<usize> = lengths(frames, ratio, factor).into_iter().filter(|&l| l >= patch).collect();
     if levels.is_empty() {
         levels.push(frames);
