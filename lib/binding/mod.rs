@@ -114,25 +114,15 @@ impl Binding {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::skeleton::Joint;
-    use glam::DVec3;
-
-    fn skeleton(names: &[&str]) -> Skeleton {
-        let joints = names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| Joint { name: n.to_string(), parent: i.checked_sub(1), offset: DVec3::Y, channels: vec![], end_sites: vec![] })
-            .collect();
-        Skeleton { joints, frame_time: 1.0 / 30.0 }
-    }
+    use crate::skeleton::chain;
 
     #[test]
     fn reads_the_reference_format_and_resolves_by_normalised_name() {
         let text = r#"{"source_name": "Flamingo", "root_joint": "Hips",
             "mapping": [{"source": "Bip01_L_Calf", "target": "LeftLeg"}, {"source": "hips", "target": "mixamorig:Hips"}]}"#;
         let b = Binding::from_json(text, "b.json").unwrap();
-        let src = skeleton(&["Hips", "Bip01_L_Calf"]);
-        let tgt = skeleton(&["mixamorig:Hips", "mixamorig:LeftLeg"]);
+        let src = chain(&["Hips", "Bip01_L_Calf"]);
+        let tgt = chain(&["mixamorig:Hips", "mixamorig:LeftLeg"]);
         assert_eq!(b.resolve("b.json", &src, "s.bvh", &tgt, "t.bvh").unwrap(), vec![(1, 1), (0, 0)]);
         let again = Binding::from_json(&b.to_json(), "again").unwrap();
         assert_eq!(again.mapping, b.mapping);
@@ -141,8 +131,8 @@ mod tests {
 
     #[test]
     fn unknown_duplicate_and_empty_are_errors() {
-        let src = skeleton(&["Hips", "Spine"]);
-        let tgt = skeleton(&["Root", "Chest"]);
+        let src = chain(&["Hips", "Spine"]);
+        let tgt = chain(&["Root", "Chest"]);
         let unknown = Binding::from_json(r#"{"mapping": [{"source": "Hip", "target": "Root"}]}"#, "b").unwrap();
         let e = unknown.resolve("b", &src, "s", &tgt, "t").unwrap_err().to_string();
         assert!(e.contains("pair 0: source joint: s: no joint named 'Hip' (closest: Hips"), "{e}");

@@ -85,21 +85,11 @@ fn edit_distance(a: &[char], b: &[char]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::skeleton::Joint;
-    use glam::DVec3;
-
-    fn skeleton(names: &[&str]) -> Skeleton {
-        let joints = names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| Joint { name: n.to_string(), parent: i.checked_sub(1), offset: DVec3::Y, channels: vec![], end_sites: vec![] })
-            .collect();
-        Skeleton { joints, frame_time: 1.0 / 30.0 }
-    }
+    use crate::skeleton::chain;
 
     #[test]
     fn exact_then_case_then_namespace_then_normalised() {
-        let s = skeleton(&["Hips", "mixamorig:LeftUpLeg", "Bip01_L_Foot", "HandThumb1"]);
+        let s = chain(&["Hips", "mixamorig:LeftUpLeg", "Bip01_L_Foot", "HandThumb1"]);
         assert_eq!(find_joint(&s, "Hips"), Ok(0));
         assert_eq!(find_joint(&s, "hips"), Ok(0));
         assert_eq!(find_joint(&s, "leftupleg"), Ok(1));
@@ -109,7 +99,7 @@ mod tests {
 
     #[test]
     fn never_by_substring_and_lists_closest() {
-        let s = skeleton(&["Hips", "HandThumb1", "Spine"]);
+        let s = chain(&["Hips", "HandThumb1", "Spine"]);
         match find_joint(&s, "Hand") {
             Err(LookupError::Unknown { closest, .. }) => assert_eq!(closest[0], "Hips"),
             other => panic!("expected Unknown, got {other:?}"),
@@ -119,7 +109,7 @@ mod tests {
 
     #[test]
     fn ambiguous_keys_are_errors() {
-        let s = skeleton(&["a:Hips", "b:Hips"]);
+        let s = chain(&["a:Hips", "b:Hips"]);
         assert!(matches!(find_joint(&s, "hips"), Err(LookupError::Ambiguous { .. })));
         assert_eq!(find_joint(&s, "a:Hips"), Ok(0));
     }

@@ -42,6 +42,18 @@ pub enum SkeletonError {
     Roots(usize),
 }
 
+/// A chain of joints with these names, each one unit above its parent: the smallest skeleton
+/// that name-lookup and binding tests need.
+#[cfg(test)]
+pub(crate) fn chain(names: &[&str]) -> Skeleton {
+    let joints = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| Joint { name: n.to_string(), parent: i.checked_sub(1), offset: DVec3::Y, channels: vec![], end_sites: vec![] })
+        .collect();
+    Skeleton { joints, frame_time: 1.0 / 30.0 }
+}
+
 impl Skeleton {
     pub fn from_bvh(bvh: &Bvh) -> Skeleton {
         let joints = bvh

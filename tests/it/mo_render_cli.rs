@@ -37,7 +37,7 @@ fn a_glb_draws_like_the_bvh_it_came_from() {
     let (b, width_b, _) = sheet(&glb, "from_glb.png");
     assert_eq!((a.len(), width), (b.len(), width_b), "the same sheet size");
     // The title line names the file (.bvh or .glb); below it the pictures match, but for a few
-    // anti-aliased edge pixels that the GLB's float32 values move (5 of 250,000 when written).
+    // anti-aliased edge pixels that the GLB's float32 values move (5 of 220,000 when written).
     let title = 24 * width * samples;
     let pixels = (a.len() - title) / samples;
     let differ = a[title..].chunks(samples).zip(b[title..].chunks(samples)).filter(|(x, y)| x != y).count();
