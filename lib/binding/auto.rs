@@ -4,8 +4,9 @@
 //!
 //! Motion2Motion's appendix A binds the few most similar bone chains (a 6.1% binding rate).
 //! Our binder binds every confident pair instead (`correspond::bindable`: both joints move a
-//! bone, same side, same limb pair, neither joint has a better partner, no toes; and each
-//! matched limb tied at its first joint and its end: foot, hand, tip): a binding that ties
+//! bone, same side, same limb pair, neither joint has a better partner, no toes, the same place
+//! along both limbs with bones pointing the same way; and each matched limb tied at its first
+//! joint and its end: foot, hand, tip, or a bird's and a mammal's ankles): a binding that ties
 //! each leg to its leg and the spine to the spine is what a person writes by hand, and on
 //! real rigs the few-pairs binding left limbs to chance (issue 24). `rate` stays as a limit
 //! for those who want the paper's setting. When fewer than `min_pairs` pairs are confident,

@@ -282,32 +282,47 @@ fn sort_pairs(pairs: &mut [Pair]) {
 /// The compatible pairs worth binding, and each matched limb tied at both ends, as a person
 /// binds by hand:
 ///
-/// * limbs are matched first (`match_limbs`: per side and limb pair, in order along the body);
-///   a pair that joins two limbs that are not matched is dropped;
+/// * limbs are matched first (`match_limbs`: per side and limb pair, in order along the body),
+///   but never a limb of a single bone with one of three or more (`comparable_limbs`: a bird's
+///   one-bone wing stub is no arm); a pair that joins two limbs that are not matched is dropped;
 /// * a joint pair is bound when it is confident (neither joint had a better partner,
-///   `margin` >= 0, and the evidence is positive overall) and `end_ok`;
+///   `margin` >= 0, and the evidence is positive overall), `end_ok`, and, inside a matched
+///   limb, in the same place along both limbs (`chain_position` within `CHAIN_PLACE_TOLERANCE`:
+///   a dog's upper foreleg is not a claw's last joint, whatever the names say) with its bones
+///   pointing the same way in both rest poses (`BONE_AGREEMENT`: a knee bent forward is not
+///   bound to one folded up under a sitting dog);
 /// * every matched front or hind limb's first joint binds to the other's first joint, and its
 ///   end effector (the hand, foot or tip the limb ends in) to the other's, when `end_ok` and
-///   neither joint is bound already.
+///   neither joint is bound already; where two legs ending in toes differ in length above
+///   their feet, their ankles instead (`ankles`).
 ///
 /// Ends were once never bound (a rule from Flamingo -> Monkey alone); the hand bindings of
 /// the corpus pairs tie exactly them, and without them the automatic binding's frequency
 /// alignment fell short of a hand binding's (docs/retarget-results.md).
 pub fn bindable(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
     let (a, b) = (&scores.source, &scores.target);
-    let limbs = match_limbs(a, b);
-    let consistent = |p: &Pair| match (a.base[p.source], b.base[p.target]) {
-        (Some(x), Some(y)) => limbs.contains(&(x, y)),
+    let limbs: Vec<(usize, usize)> = match_limbs(a, b).into_iter().filter(|&(x, y)| comparable_limbs(a, x, b, y)).collect();
+    // Inside matched limbs: the same place along both, bones pointing the same way.
+    let in_place = |p: &Pair| match (a.base[p.source], b.base[p.target]) {
+        (Some(x), Some(y)) => {
+            limbs.contains(&(x, y))
+                && (chain_position(a, p.source, x) - chain_position(b, p.target, y)).abs() <= CHAIN_PLACE_TOLERANCE
+                && a.direction[p.source].dot(b.direction[p.target]) >= BONE_AGREEMENT
+        }
         _ => true,
     };
     let mut out: Vec<Pair> =
-        compatible(scores, pairs).into_iter().filter(|p| p.margin >= 0.0 && p.score > 0.0 && consistent(p) && end_ok(a, p.source, b, p.target)).collect();
+        compatible(scores, pairs).into_iter().filter(|p| p.margin >= 0.0 && p.score > 0.0 && in_place(p) && end_ok(a, p.source, b, p.target)).collect();
     for &(x, y) in &limbs {
         if !matches!(a.limb[x], Limb::Front | Limb::Hind) {
             continue;
         }
-        for (s, t) in [(x, y), (limb_end(a, x), limb_end(b, y))] {
-            if !(a.moves[s] && b.moves[t] && end_ok(a, s, b, t)) || out.iter().any(|p| p.source == s || p.target == t) {
+        let ends = (limb_end(a, x), limb_end(b, y));
+        let ankles = ankles(a, x, ends.0, b, y, ends.1, &out);
+        for (s, t) in [Some((x, y)), Some(ends), ankles].into_iter().flatten() {
+            // The ankles are tied where the feet are not: their depths differ by design.
+            let ok = if Some((s, t)) == ankles { !a.toe[s] && !b.toe[t] } else { end_ok(a, s, b, t) };
+            if !(a.moves[s] && b.moves[t] && ok) || out.iter().any(|p| p.source == s || p.target == t) {
                 continue;
             }
             if let Some(score) = scores.score[s][t] {
@@ -327,7 +342,8 @@ pub fn bindable(scores: &Scores, pairs: &[Pair]) -> Vec<Pair> {
 /// * a foot with toes below it only where both limbs have as many joints above it: which joint
 ///   is the ankle is ambiguous otherwise (a bird's `Foot` is the base of its toes, its ankle is
 ///   the `HorseLink`; binding a flamingo's and a chicken's `Foot` to a monkey's lowered frequency
-///   alignment from 0.95 to 0.87 and from 0.70 to 0.51);
+///   alignment from 0.95 to 0.87 and from 0.70 to 0.51; `ankles` ties such legs' ankles
+///   instead);
 /// * a leaf only on the midline (a head, a tail tip) or at the end of a front or hind limb (a
 ///   hand, a foot), not at the end of a limb of unknown kind (ears, eyelids, a beard).
 fn end_ok(a: &Described, s: usize, b: &Described, t: usize) -> bool {
@@ -344,6 +360,72 @@ fn end_ok(a: &Described, s: usize, b: &Described, t: usize) -> bool {
     }
     let leaf_ok = |d: &Described, j: usize| !d.leaf[j] || matches!(d.limb[j], Limb::Centre | Limb::Front | Limb::Hind);
     leaf_ok(a, s) && leaf_ok(b, t)
+}
+
+/// How far apart two joints of matched limbs may sit along them (`chain_position`, 0 at the
+/// first joint, 1 at the end effector): under a third, so one joint out of place in a
+/// three-bone limb is too far (a dog's `LeftArm` at 1/3 with a crab claw's `Arm_03` at 2/3),
+/// while chains of different lengths still pair proportionally (a human's leg with a hip joint
+/// above it, 3 bones to the ankle, with one of 2 bones: 1/3 with 1/2).
+const CHAIN_PLACE_TOLERANCE: f64 = 0.3;
+
+/// The least cosine between the bones (parent -> joint) of a bound limb pair in the two rest
+/// poses: bones pointing into opposite half-spaces turn opposite ways when one's rotation
+/// drives the other. (A human's knee below the hip against a sitting dog's knee above it:
+/// binding them lowered LAFAN1 -> Dog's frequency alignment from 0.64 to 0.43.)
+const BONE_AGREEMENT: f64 = 0.0;
+
+/// The ankles of two legs that end in toes but differ in length above their feet: a bird's
+/// leg has one more segment than a mammal's, the tarsometatarsus, below its ankle (the
+/// `HorseLink`), so its `Foot` is the base of its toes while a monkey's `Foot` is its ankle.
+/// Hip, knee and ankle come in the same order in both, so the ankles are the joints one step
+/// further down each leg's main chain than the deepest pair already bound inside the limb (the
+/// knees, or the limbs' first joints). `None` when the feet are at the same depth (they are
+/// tied as ends), when either has no toes, or when the bound pair is already at a foot.
+fn ankles(a: &Described, x: usize, ea: usize, b: &Described, y: usize, eb: usize, bound: &[Pair]) -> Option<(usize, usize)> {
+    let toes_below = |d: &Described, j: usize| (0..d.parents.len()).any(|c| d.parents[c] == Some(j) && d.toe[c]);
+    if !(toes_below(a, ea) && toes_below(b, eb)) || depth_below(a, ea, x) == depth_below(b, eb, y) {
+        return None;
+    }
+    // On the main chain from the limb's first joint to its end.
+    let on_chain = |d: &Described, j: usize, base: usize, end: usize| d.base[j] == Some(base) && ancestor_at(d, end, base, depth_below(d, j, base)) == j;
+    let (s, t) = bound
+        .iter()
+        .filter(|p| on_chain(a, p.source, x, ea) && on_chain(b, p.target, y, eb))
+        .map(|p| (p.source, p.target))
+        .chain([(x, y)])
+        .max_by_key(|&(s, t)| (depth_below(a, s, x) + depth_below(b, t, y), std::cmp::Reverse(s), std::cmp::Reverse(t)))?;
+    if s == ea || t == eb {
+        return None;
+    }
+    Some((ancestor_at(a, ea, x, depth_below(a, s, x) + 1), ancestor_at(b, eb, y, depth_below(b, t, y) + 1)))
+}
+
+/// The ancestor of `j` (or `j`) that is `depth` joints below `base`.
+fn ancestor_at(d: &Described, j: usize, base: usize, depth: usize) -> usize {
+    let mut cur = j;
+    while depth_below(d, cur, base) > depth {
+        match d.parents[cur] {
+            Some(p) => cur = p,
+            None => break,
+        }
+    }
+    cur
+}
+
+/// Where `j` sits along the limb starting at `base`: 0 at `base`, 1 at its end effector
+/// (`limb_end`), above 1 in the digits past it.
+fn chain_position(d: &Described, j: usize, base: usize) -> f64 {
+    depth_below(d, j, base) as f64 / depth_below(d, limb_end(d, base), base).max(1) as f64
+}
+
+/// Whether two limbs (by their first joints) may be tied: not a limb of a single bone with one
+/// of three or more bones to its end effector. A bird's one-bone wing stub held against its
+/// body does not carry what a monkey's arm does when it walks on it (binding them lowered
+/// Chicken -> Monkey's frequency alignment by 0.04).
+fn comparable_limbs(a: &Described, x: usize, b: &Described, y: usize) -> bool {
+    let (na, nb) = (depth_below(a, limb_end(a, x), x), depth_below(b, limb_end(b, y), y));
+    !(na.min(nb) == 1 && na.max(nb) >= 3)
 }
 
 /// Joints from `ancestor` down to `j`.
@@ -413,6 +495,141 @@ pub(crate) mod tests {
         let (skeleton, _) = synth::creature(name, 1).unwrap();
         let rest = skeleton.rest_positions();
         (skeleton, rest)
+    }
+
+    /// A skeleton from (name, parent, offset) rows, every leaf with an End Site, and its rest
+    /// positions (facing +z, y up).
+    fn rig(rows: &[(&str, Option<usize>, [f64; 3])]) -> (Skeleton, Vec<DVec3>) {
+        use crate::skeleton::Joint;
+        let joints = rows
+            .iter()
+            .enumerate()
+            .map(|(j, (name, parent, offset))| Joint {
+                name: name.to_string(),
+                parent: *parent,
+                offset: DVec3::from_array(*offset),
+                channels: vec![],
+                end_sites: if rows.iter().any(|r| r.1 == Some(j)) { vec![] } else { vec![DVec3::new(0.0, -0.2, 0.2)] },
+            })
+            .collect();
+        let skeleton = Skeleton { joints, frame_time: 1.0 / 30.0 };
+        let rest = skeleton.rest_positions();
+        (skeleton, rest)
+    }
+
+    /// A body with a spine, a head and two legs (the left one mirrored to the right); `leg` is
+    /// the left leg below the hip as (name, offset from the parent) down the chain, `toes` the
+    /// toes under its last joint, `arm` the left front limb from the chest.
+    fn creature(leg: &[(&str, [f64; 3])], toes: &[(&str, [f64; 3])], arm: &[(&str, [f64; 3])]) -> (Skeleton, Vec<DVec3>) {
+        let mut rows: Vec<(String, Option<usize>, [f64; 3])> = vec![
+            ("Hips".into(), None, [0.0, 10.0, 0.0]),
+            ("Bip01_Spine".into(), Some(0), [0.0, 0.0, 2.0]),
+            ("Bip01_Neck".into(), Some(1), [0.0, 1.0, 2.0]),
+            ("Bip01_Head".into(), Some(2), [0.0, 1.0, 1.0]),
+        ];
+        for (side, sign) in [("L", 1.0), ("R", -1.0)] {
+            let mirror = |o: [f64; 3]| [sign * o[0], o[1], o[2]];
+            let mut parent = 0;
+            for (k, (name, offset)) in leg.iter().enumerate() {
+                let offset = if k == 0 { mirror([1.0, 0.0, 0.0]) } else { mirror(*offset) };
+                rows.push((format!("Bip01_{side}_{name}"), Some(parent), offset));
+                parent = rows.len() - 1;
+            }
+            let foot = parent;
+            for (name, offset) in toes {
+                rows.push((format!("Bip01_{side}_{name}"), Some(foot), mirror(*offset)));
+            }
+            parent = 1;
+            for (name, offset) in arm {
+                rows.push((format!("Bip01_{side}_{name}"), Some(parent), mirror(*offset)));
+                parent = rows.len() - 1;
+            }
+        }
+        let rows: Vec<(&str, Option<usize>, [f64; 3])> = rows.iter().map(|(n, p, o)| (n.as_str(), *p, *o)).collect();
+        rig(&rows)
+    }
+
+    /// A bird: hip, knee, ankle (`HorseLink`), the long tarsometatarsus down to `Foot`, the base
+    /// of its toes; a one-bone wing.
+    fn bird() -> (Skeleton, Vec<DVec3>) {
+        creature(
+            &[("Thigh", [0.0; 3]), ("Calf", [0.0, -3.0, 1.0]), ("HorseLink", [0.0, -3.0, -1.0]), ("Foot", [0.0, -3.5, 0.5])],
+            &[("Toe0", [0.0, -0.4, 1.0]), ("Toe1", [0.3, -0.4, 1.0])],
+            &[("Finger_01", [1.5, 0.5, 0.0]), ("Finger_02", [0.0, 0.0, -3.0])],
+        )
+    }
+
+    /// A monkey: hip, knee, `Foot` (its ankle) with its toes; a four-joint arm reaching down.
+    fn mammal() -> (Skeleton, Vec<DVec3>) {
+        creature(
+            &[("Thigh", [0.0; 3]), ("Calf", [0.0, -4.5, 0.5]), ("Foot", [0.0, -4.5, -0.5])],
+            &[("Toe0", [0.0, -0.8, 1.0]), ("Toe1", [0.3, -0.8, 1.0])],
+            &[("Clavicle", [1.0, 0.0, 0.0]), ("UpperArm", [1.0, -0.5, 0.0]), ("Forearm", [0.0, -4.0, 0.3]), ("Hand", [0.0, -4.0, -0.3])],
+        )
+    }
+
+    fn bound(a: &(Skeleton, Vec<DVec3>), b: &(Skeleton, Vec<DVec3>), edit: impl Fn(&mut Scores)) -> Vec<(String, String)> {
+        let mut sc = scores(&Body { skeleton: &a.0, rest: &a.1 }, &Body { skeleton: &b.0, rest: &b.1 }, Evidence::ALL, None).unwrap();
+        edit(&mut sc);
+        bindable(&sc, &assign(&sc)).iter().map(|p| (a.0.joints[p.source].name.clone(), b.0.joints[p.target].name.clone())).collect()
+    }
+
+    fn has(pairs: &[(String, String)], s: &str, t: &str) -> bool {
+        pairs.iter().any(|(x, y)| x == s && y == t)
+    }
+
+    #[test]
+    fn a_birds_ankle_binds_to_a_mammals_ankle_and_its_wing_stays_out() {
+        let (b, m) = (bird(), mammal());
+        for (pairs, bird_first) in [(bound(&b, &m, |_| {}), true), (bound(&m, &b, |_| {}), false)] {
+            let bird_of = |p: &(String, String)| if bird_first { p.0.clone() } else { p.1.clone() };
+            let pair = |x: &str, y: &str| if bird_first { has(&pairs, x, y) } else { has(&pairs, y, x) };
+            for side in ["L", "R"] {
+                let j = |n: &str| format!("Bip01_{side}_{n}");
+                assert!(pair(&j("Thigh"), &j("Thigh")) && pair(&j("Calf"), &j("Calf")), "{pairs:?}");
+                // The HorseLink is the bird's ankle; its Foot (the base of its toes) is not.
+                assert!(pair(&j("HorseLink"), &j("Foot")), "{side}: no ankle pair in {pairs:?}");
+                assert!(!pairs.iter().any(|p| bird_of(p) == j("Foot")), "{side}: the bird's Foot is bound: {pairs:?}");
+                // A one-bone wing is no arm.
+                assert!(!pairs.iter().any(|p| bird_of(p).contains("Finger")), "{side}: the wing is bound: {pairs:?}");
+            }
+        }
+        // Two mammals: the feet are the limbs' ends (no ankle rule), arms tied at both ends.
+        let pairs = bound(&m, &m, |_| {});
+        assert!(
+            has(&pairs, "Bip01_L_Foot", "Bip01_L_Foot") && has(&pairs, "Bip01_L_Clavicle", "Bip01_L_Clavicle") && has(&pairs, "Bip01_L_Hand", "Bip01_L_Hand"),
+            "{pairs:?}"
+        );
+    }
+
+    #[test]
+    fn limb_pairs_keep_their_place_along_the_limb() {
+        let m = mammal();
+        let idx = |n: &str| m.0.index_of(n).unwrap();
+        let (upper, fore) = (idx("Bip01_L_UpperArm"), idx("Bip01_L_Forearm"));
+        // Evidence (names, say) that swaps the upper arm and the forearm: each one joint out of
+        // place in a three-bone arm.
+        let swapped = bound(&m, &m, |sc| {
+            sc.score[upper][fore] = Some(5.0);
+            sc.score[fore][upper] = Some(5.0);
+        });
+        assert!(!has(&swapped, "Bip01_L_UpperArm", "Bip01_L_Forearm") && !has(&swapped, "Bip01_L_Forearm", "Bip01_L_UpperArm"), "{swapped:?}");
+        assert!(has(&swapped, "Bip01_L_Clavicle", "Bip01_L_Clavicle") && has(&swapped, "Bip01_L_Hand", "Bip01_L_Hand"), "{swapped:?}");
+        assert!(has(&bound(&m, &m, |_| {}), "Bip01_L_UpperArm", "Bip01_L_UpperArm"));
+    }
+
+    #[test]
+    fn a_knee_bent_the_other_way_is_not_bound() {
+        let m = mammal();
+        // The same creature sitting: its left knee above the hip, the shin folded back down.
+        let mut sitting = m.0.clone();
+        let (calf, foot) = (sitting.index_of("Bip01_L_Calf").unwrap(), sitting.index_of("Bip01_L_Foot").unwrap());
+        sitting.joints[calf].offset = DVec3::new(1.0, 3.0, 3.0);
+        sitting.joints[foot].offset = DVec3::new(0.0, -7.0, 0.5);
+        let rest = sitting.rest_positions();
+        let pairs = bound(&m, &(sitting, rest), |_| {});
+        assert!(!has(&pairs, "Bip01_L_Calf", "Bip01_L_Calf"), "{pairs:?}");
+        assert!(has(&pairs, "Bip01_R_Calf", "Bip01_R_Calf") && has(&pairs, "Bip01_L_Thigh", "Bip01_L_Thigh"), "{pairs:?}");
     }
 
     #[test]

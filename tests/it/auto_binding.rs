@@ -143,12 +143,28 @@ fn limb_ends_bind_to_their_own_limb_ends() {
     report("Dog -> Crab", &sa, &sb, &pairs, |_| true);
     assert!(has(&sa, &sb, &pairs, "LeftFoot", "DEF_BN_Leg_L_15_end") && has(&sa, &sb, &pairs, "RightFoot", "DEF_BN_Leg_R_15_end"), "Dog -> Crab: hind feet");
     assert!(has(&sa, &sb, &pairs, "LeftHand", "DEF_BN_Arm_L_03_end") && has(&sa, &sb, &pairs, "RightHand", "DEF_BN_Arm_R_03_end"), "Dog -> Crab: fore feet");
-    // Flamingo -> Monkey: a bird's Foot is the base of its toes, a monkey's its ankle; the legs
-    // differ in length above them, so neither Foot is bound.
+    // Dog -> crab: the dog's upper foreleg is not the claw's last joint (one joint out of place
+    // along a three-bone limb), whatever the word "Arm" says.
+    assert!(!has(&sa, &sb, &pairs, "LeftArm", "DEF_BN_Arm_L_03") && !has(&sa, &sb, &pairs, "RightArm", "DEF_BN_Arm_R_03"), "Dog -> Crab: arm out of place");
+    // LAFAN1 -> Dog: the dog sits in its first frame, its knees above its hips: a human knee
+    // is not bound to them.
+    let (sa, sb, pairs) = bind(&bvh.join("lafan1/walk4_subject1.bvh"), &bvh.join("dog_mann/Dog/D1_007_KAN01_001.bvh"), &AutoOptions::default());
+    assert!(!has(&sa, &sb, &pairs, "LeftLeg", "LeftLeg") && !has(&sa, &sb, &pairs, "RightLeg", "RightLeg"), "LAFAN1 -> Dog: knees");
+    // Flamingo and Chicken -> Monkey: a bird's Foot is the base of its toes, its ankle the
+    // HorseLink; a monkey's Foot is its ankle. The ankles are bound, the bird's Foot is not;
+    // the chicken's one-bone wings are not bound to the monkey's arms.
     let fm = data.join("bvh/truebones_motion2motion");
-    let (sa, sb, pairs) = bind(&fm.join("Flamingo/Flamingo_Walk.bvh"), &fm.join("Monkey/__Walk.bvh"), &AutoOptions::default());
-    assert!(
-        !pairs.iter().any(|c| sa.joints[c.source].name.contains("_Foot") || sb.joints[c.target].name.contains("_Foot")),
-        "Flamingo -> Monkey: a Foot is bound"
-    );
+    for bird in [fm.join("Flamingo/Flamingo_Walk.bvh"), bvh.join("truebones_anytop/Chicken/Chicken_Walk.bvh")] {
+        let (sa, sb, pairs) = bind(&bird, &fm.join("Monkey/__Walk.bvh"), &AutoOptions::default());
+        report(&format!("{} -> Monkey", bird.display()), &sa, &sb, &pairs, |_| true);
+        let bare = |n: &str| n.split("__").next().unwrap_or(n).to_string();
+        for side in ["L", "R"] {
+            let ankle = pairs.iter().any(|c| {
+                bare(&sa.joints[c.source].name) == format!("Bip01_{side}_HorseLink") && bare(&sb.joints[c.target].name) == format!("Bip01_{side}_Foot")
+            });
+            assert!(ankle, "{}: {side} ankles not bound", bird.display());
+        }
+        assert!(!pairs.iter().any(|c| sa.joints[c.source].name.contains("_Foot")), "{}: the bird's Foot is bound", bird.display());
+        assert!(!pairs.iter().any(|c| sa.joints[c.source].name.contains("Finger")), "{}: a wing finger is bound", bird.display());
+    }
 }
