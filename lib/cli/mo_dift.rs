@@ -39,8 +39,9 @@ EXAMPLES:
 /// joint; score cosine, margin best minus second best). --as-binding writes instead a binding
 /// REF -> TGT that `mo-retarget REF.bvh TGT.bvh --bind bind.json` reads: combined, exactly
 /// what --bind auto binds (every confident pair of joints that move a bone, same side, same
-/// limb pair, no toes, and each matched limb tied at its first joint and its end: foot, hand
-/// or tip; at most --bind-rate); dift-only, mutual best pairs of joints that move a bone,
+/// limb pair, no toes, the same place along matched limbs with bones pointing the same way,
+/// and each matched limb tied at its first joint and its end: foot, hand, tip or ankle; at
+/// most --bind-rate); dift-only, mutual best pairs of joints that move a bone,
 /// most similar first, as many as --bind-rate asks for (default 0.061, the paper's rate).
 ///
 /// --frames REF TGT: frame correspondence, a REF frame for every TGT frame, as JSON. Frame

@@ -41,8 +41,10 @@ EXAMPLES:
 /// or by normalised name, never by substring. --bind auto binds every confident pair of the
 /// joint correspondence that `mo-dift --joints` prints (names with their sides and ordinals,
 /// front and hind limbs, topology and rest pose, one to one): the same side, the same limb
-/// pair, joints that move a bone, no toes, and each matched limb tied at its first joint and
-/// its end (foot, hand or tip); --bind-rate R keeps at most that rate (the paper's 0.061
+/// pair, joints that move a bone, no toes, inside a limb the same place along both limbs with
+/// bones pointing the same way, no one-bone limb with a jointed one, and each matched limb tied
+/// at its first joint and its end (foot, hand or tip; a bird's and a mammal's ankles where
+/// their legs differ below the knee); --bind-rate R keeps at most that rate (the paper's 0.061
 /// gives its sparse binding); --emit-binding prints it as JSON to inspect, edit and reuse
 /// instead of retargeting.
 ///
