@@ -106,7 +106,6 @@ EXAMPLES:
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-encode", version, after_long_help = EXAMPLES)]
 #[command(group = clap::ArgGroup::new("latents").args(["latent", "decode_latent"]))]
-#[command(group = clap::ArgGroup::new("rig").multiple(true).args(RIG_FLAGS))]
 pub struct Args {
     /// BVH files to encode ('-' = stdin); with --decode or --decode-latent, one NPY file
     /// (default: stdin).
@@ -187,11 +186,11 @@ pub struct Args {
     pub normalised: bool,
     /// Encode one BVH clip into per-frame latents of the latent model (SATA): NPY [frames - 1,
     /// latent], the same size for every skeleton.
-    #[arg(long, conflicts_with_all = ["decode", "repr", "rig", "skeleton"])]
+    #[arg(long, conflicts_with_all = ["decode", "repr", "skeleton"], conflicts_with_all = RIG_FLAGS)]
     pub latent: bool,
     /// Decode latents (NPY [frames, latent] from --latent) onto --skeleton, any skeleton, as
     /// BVH.
-    #[arg(long, requires = "skeleton", conflicts_with_all = ["decode", "repr", "rig"])]
+    #[arg(long, requires = "skeleton", conflicts_with_all = ["decode", "repr"], conflicts_with_all = RIG_FLAGS)]
     pub decode_latent: bool,
     /// The latent model: a directory from 'mo-train --arch sata' [default: the built-in one].
     #[arg(long, value_name = "DIR", requires = "latents")]
