@@ -213,9 +213,9 @@ complete -c mo-edit -n "__fish_mo_edit_using_subcommand rename" -s q -l quiet -d
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rename" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand rename" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l blend -d 'Seconds of easing into and out of each contact' -r
-complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l ground -d 'Ground: \'zero\', \'estimate\' or a height (as mo-metrics physics)' -r
-complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l contact-height -r
-complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l contact-speed -r
+complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l ground -d 'Ground: \'zero\' (y = 0), \'estimate\' (lowest foot height over the clip) or a height' -r
+complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l contact-height -d 'Contact height threshold, as a fraction of the skeleton\'s size' -r
+complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l contact-speed -d 'Contact speed threshold, as a fraction of the skeleton\'s size per second' -r
 complete -c mo-edit -n "__fish_mo_edit_using_subcommand foot-lock" -l format -d 'Output format when -o has no telling extension or is stdout' -r -f -a "bvh\t''
 glb\t'Binary glTF (skin, animation, a stick mesh)'
 gltf\t'glTF JSON, data inlined'

@@ -16,14 +16,14 @@ complete -c mo-retarget -l patch -d 'Patch length in frames (paper: 11)' -r
 complete -c mo-retarget -l alpha -d 'Weight of the bound (source) channels in matching, 0..1 (paper: 0.85)' -r
 complete -c mo-retarget -l steps -d 'Match-and-blend iterations per pyramid level (paper: 3)' -r
 complete -c mo-retarget -l pyramid -d 'Scale between pyramid levels (paper: 0.75)' -r
-complete -c mo-retarget -l repr -d 'Matching features (paper table 4)' -r -f -a "rotation\t''
-velocity\t''
-position\t''"
-complete -c mo-retarget -l bound-rotation -d 'How bound joints take the source\'s rotation' -r -f -a "local\t'Copy the source\'s local rotations (the reference\'s behaviour)'
-aligned\t'Rotate bound bones so their directions follow the source\'s, relative to each rest pose'
-world\t'Match the source\'s world rotations'"
-complete -c mo-retarget -l root-motion -d 'Where the root trajectory comes from' -r -f -a "examples\t'From the examples\' patches (the reference\'s behaviour)'
-source\t'The source\'s trajectory, scaled to the target\'s size'"
+complete -c mo-retarget -l repr -d 'Matching features (paper table 4)' -r -f -a "rotation\t'Local 6D rotations of every joint plus the root\'s dx, y, dz (the paper\'s default)'
+velocity\t'World joint velocities (per frame) plus the root\'s dx, y, dz'
+position\t'Joint positions relative to the root (translation only) plus the root\'s dx, y, dz'"
+complete -c mo-retarget -l bound-rotation -d 'How bound joints take the source\'s rotation' -r -f -a "local\t'The source\'s local rotation, copied as is (the reference\'s behaviour)'
+aligned\t'The source\'s local rotation expressed about the target bone: conjugated by the rest rotation that turns the target bone direction onto the source\'s, so a bone that points down the -y axis on one skeleton and along +z on the other still swings the same way'
+world\t'The target joint gets the source joint\'s orientation relative to the root (world rotation with the root\'s removed), whatever its parents do'"
+complete -c mo-retarget -l root-motion -d 'Where the root trajectory comes from' -r -f -a "examples\t'Synthesised from the examples like any unbound channel (the reference\'s behaviour)'
+source\t'The source\'s root trajectory scaled by the ratio of the skeletons\' hip heights; the root position channels are then bound channels'"
 complete -c mo-retarget -s o -l output -d 'Write output here instead of stdout (\'-\' = stdout). Files are written atomically' -r -F
 complete -c mo-retarget -l seed -d 'Seed for everything random; the same seed and input give byte-identical output' -r
 complete -c mo-retarget -l threads -d 'Worker threads (default: all cores; at most 256). Output never depends on this' -r

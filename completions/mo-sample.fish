@@ -4,8 +4,8 @@ complete -c mo-sample -s n -l samples -d 'Number of samples' -r
 complete -c mo-sample -l frames -d 'Frames per sample [default: 120; with --reference: the reference\'s length; with --examples: the longest clip\'s]' -r
 complete -c mo-sample -l seconds -d 'Length in seconds (at the skeleton\'s frame rate)' -r
 complete -c mo-sample -l steps -d 'Diffusion steps to visit (1..=100)' -r
-complete -c mo-sample -l sampler -d 'Sampler' -r -f -a "ddpm\t''
-ddim\t''"
+complete -c mo-sample -l sampler -d 'Sampler' -r -f -a "ddpm\t'Ancestral DDPM (the reference\'s, on all steps; respaced on fewer)'
+ddim\t'Deterministic DDIM (η = 0)'"
 complete -c mo-sample -l bvh -d 'Write BVH files instead of NPY (\'{i}\' becomes the sample index); named .glb or .gltf: glTF' -r -F
 complete -c mo-sample -l reference -d 'A clip of the same skeleton (BVH) to keep parts of (needs --keep-frames or --keep-joints)' -r -F
 complete -c mo-sample -l keep-frames -d 'In-betweening: output frames taken from the reference, e.g. \'0-19,100-119\' (inclusive)' -r

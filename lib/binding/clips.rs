@@ -24,6 +24,8 @@ pub enum ClipBindError {
     Correspond(#[from] CorrespondError),
     #[error(transparent)]
     Auto(#[from] AutoError),
+    #[error(transparent)]
+    Binding(#[from] super::BindingError),
 }
 
 /// The AnyTop rig's natural rest pose of a clip's skeleton: faces +z.
@@ -31,6 +33,17 @@ pub fn facing_rest(clip: &Clip) -> Result<Vec<DVec3>, ClipBindError> {
     let section = AnyTopSection::new(&clip.skeleton, &clip.motion.first_frames(2), &RigOptions::default())
         .map_err(|source| ClipBindError::Rest { name: clip.name.clone(), source })?;
     Ok(section.rig.rest_positions(&clip.skeleton))
+}
+
+/// The binding `mo-retarget --bind` names: `auto` (`bind_auto`, at most `rate`) or a binding
+/// file; as joint pairs, and as the document `--emit-binding` writes.
+pub fn binding_for(bind: &str, source: &Clip, target: &Clip, rate: Option<f64>) -> Result<(super::JointMap, super::Binding), ClipBindError> {
+    if bind != "auto" {
+        return Ok(super::Binding::read_resolved(std::path::Path::new(bind), source, target)?);
+    }
+    let choices = bind_auto(source, target, rate)?;
+    let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &target.skeleton, &target.name);
+    Ok((choices.iter().map(|c| (c.source, c.target)).collect(), binding))
 }
 
 /// Every pair's score (all evidence), source joints in rows.

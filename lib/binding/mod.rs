@@ -51,6 +51,14 @@ pub enum BindingError {
     Name { file: String, pair: usize, side: &'static str, skeleton: String, error: Box<lookup::LookupError> },
     #[error("{file}: pairs {first} and {second} both bind {side} joint '{joint}'")]
     Duplicate { file: String, first: usize, second: usize, side: &'static str, joint: String },
+    #[error("cannot read binding {file}")]
+    Read {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{file}: not UTF-8 text")]
+    NotText { file: String },
 }
 
 impl Binding {
@@ -61,6 +69,16 @@ impl Binding {
             return Err(BindingError::Empty { file: file.to_string() });
         }
         Ok(binding)
+    }
+
+    /// Read a binding file (`-` = stdin) and resolve it from `source`'s skeleton to
+    /// `target`'s: the joint pairs and the binding as read.
+    pub fn read_resolved(path: &std::path::Path, source: &crate::motion::Clip, target: &crate::motion::Clip) -> Result<(JointMap, Binding), BindingError> {
+        let file = crate::io::display_name(path);
+        let bytes = crate::io::read_input(path).map_err(|source| BindingError::Read { file: file.clone(), source })?;
+        let text = String::from_utf8(bytes).map_err(|_| BindingError::NotText { file: file.clone() })?;
+        let binding = Binding::from_json(&text, &file)?;
+        Ok((binding.resolve(&file, &source.skeleton, &source.name, &target.skeleton, &target.name)?, binding))
     }
 
     /// Pretty JSON with our format tag, one pair per line group.

@@ -6,15 +6,13 @@
 //! through this one door, and writes it through `motion_bytes`.
 
 use crate::input::{self, ReadMotions, SkeletonFile};
-use crate::motion::{clip, Clip, Motion};
+use crate::motion::{clip, Clip};
 use crate::repr::batch::PoseFrom;
-use crate::skeleton::Skeleton;
 use crate::{bvh, gltf};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 pub use crate::input::{expand_inputs, is_dash};
-pub use crate::motion::clip::is_gltf;
 pub use crate::motion::write::MotionFormat;
 pub use crate::repr::batch::{split_samples, FeatureDecoder};
 
@@ -31,19 +29,9 @@ pub fn gltf_options() -> gltf::ReadOptions {
     GLTF_OPTIONS.lock().unwrap_or_else(|e| e.into_inner()).clone().unwrap_or_default()
 }
 
-/// The skeleton and motion of a glTF file (`--animation`, `--fps` as given for this run).
-pub fn read_gltf(bytes: &[u8], name: &str, path: &Path) -> anyhow::Result<(Skeleton, Motion)> {
-    Ok(clip::read_gltf(bytes, name, path, &gltf_options())?)
-}
-
 /// A motion file as BVH data (`motion::clip::parse_motion` with this run's glTF options).
 pub fn parse_motion(bytes: &[u8], name: &str, path: &Path) -> anyhow::Result<bvh::Bvh> {
     Ok(clip::parse_motion(bytes, name, path, &gltf_options())?)
-}
-
-/// One motion file (BVH or glTF) as a clip.
-pub fn read_clip(path: &Path) -> anyhow::Result<Clip> {
-    Ok(Clip::read_with(path, &gltf_options())?)
 }
 
 /// A clip from the bytes of a motion file already read (to look at them first).
@@ -51,32 +39,9 @@ pub fn clip_from_bytes(bytes: &[u8], name: &str, path: &Path) -> Result<Clip, cl
     Clip::from_bytes(bytes, name, path, &gltf_options())
 }
 
-/// Where AnyTop decoding takes the rotations from.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DecodeFrom {
-    /// The features' 6D rotations: exact for encoded features.
-    Rotations,
-    /// The features' joint positions, by inverse kinematics: for generated features.
-    Positions,
-}
-
-impl From<DecodeFrom> for PoseFrom {
-    fn from(from: DecodeFrom) -> PoseFrom {
-        match from {
-            DecodeFrom::Rotations => PoseFrom::Rotations,
-            DecodeFrom::Positions => PoseFrom::Positions,
-        }
-    }
-}
-
 /// Read `--skeleton`, recognised by content.
 pub fn read_skeleton(path: &Path) -> anyhow::Result<SkeletonFile> {
     Ok(SkeletonFile::read(path, &gltf_options())?)
-}
-
-/// A skeleton from a skeleton document (JSON) or a BVH file, recognised by content.
-pub fn load_skeleton(path: &Path) -> anyhow::Result<Skeleton> {
-    Ok(read_skeleton(path)?.skeleton)
 }
 
 /// How `load_motions` reads NPY inputs.
@@ -85,13 +50,13 @@ pub struct LoadOptions<'a> {
     /// The skeleton NPY features are decoded on (document or BVH); BVH inputs ignore it.
     pub skeleton: Option<&'a Path>,
     /// AnyTop features: decode from rotations (default) or positions.
-    pub from: Option<DecodeFrom>,
+    pub from: Option<PoseFrom>,
 }
 
 /// Read motions from motion files and NPY feature files (`input::read_motions`).
 pub fn load_motions(inputs: &[PathBuf], options: &LoadOptions) -> anyhow::Result<Vec<Clip>> {
     let gltf = gltf_options();
-    let from = options.from.unwrap_or(DecodeFrom::Rotations).into();
+    let from = options.from.unwrap_or(PoseFrom::Rotations);
     Ok(input::read_motions(inputs, &ReadMotions { skeleton: options.skeleton, from, gltf: &gltf })?)
 }
 

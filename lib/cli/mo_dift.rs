@@ -2,9 +2,10 @@
 
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
-use crate::cli::{output, CommonOpts};
-use crate::diffusion::checkpoint::{self, FrozenDenoiser};
-use crate::dift::{self, report, DiftFeatures, DiftOptions};
+use crate::cli::CommonOpts;
+use crate::diffusion::checkpoint;
+use crate::dift::report::{self, Align};
+use crate::dift::{self, DiftFeatures, DiftOptions};
 use crate::io;
 use crate::motion::Clip;
 use anyhow::{bail, Context};
@@ -80,7 +81,7 @@ pub struct Args {
     pub as_binding: bool,
     /// With --as-binding: at most this binding rate, 2 x pairs / (REF joints + TGT joints)
     /// [default: combined, every confident pair; dift-only, 0.061].
-    #[arg(long, value_name = "R", requires = "as_binding")]
+    #[arg(long, value_name = "R", requires = "as_binding", value_parser = bounds::positive(1.0))]
     pub bind_rate: Option<f64>,
     /// With --joints: the evidence joints are matched by.
     #[arg(long, value_enum, value_name = "WHICH", default_value_t = Features::Combined, requires = "joints")]
@@ -113,24 +114,6 @@ pub enum Features {
     DiftOnly,
 }
 
-/// How `--frames` matches frames.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Align {
-    /// In time order (dynamic time warping): the answers never go back.
-    Monotonic,
-    /// Each target frame on its own: the most similar reference frame (the paper's rule).
-    Nearest,
-}
-
-impl From<Align> for report::Align {
-    fn from(align: Align) -> report::Align {
-        match align {
-            Align::Monotonic => report::Align::Monotonic,
-            Align::Nearest => report::Align::Nearest,
-        }
-    }
-}
-
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     let pairwise = args.joints || args.frames;
@@ -139,11 +122,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (true, 2) | (false, 1) => {}
         (true, n) => bail!("--joints and --frames compare two motions, REF and TGT; {n} given"),
         (false, n) => bail!("features are written for one motion; {n} given (use --joints or --frames to compare two)"),
-    }
-    if let Some(rate) = args.bind_rate {
-        if !(rate.is_finite() && rate > 0.0 && rate <= 1.0) {
-            bail!("--bind-rate must be within (0, 1], found {rate}");
-        }
     }
     if args.joints && args.features == Features::Combined {
         return combined_joints(args, &inputs);
@@ -158,18 +136,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         seed: args.common.seed,
         ..defaults
     };
-    let motions = load_motions(&inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
-    if motions.len() != inputs.len() {
-        bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
-    }
+    let motions = load_one_each(args, &inputs)?;
     let known = super::ood::Known::denoiser(args.model.as_deref(), &model.info)?;
     for m in &motions {
         known.warn("mo-dift", &m.name, &m.skeleton, args.common.quiet)?;
     }
-    let features: Vec<DiftFeatures> = motions.iter().map(|m| features_of(&model, m, &opts, &device)).collect::<anyhow::Result<_>>()?;
+    let features: Vec<DiftFeatures> = motions.iter().map(|m| dift::of_clip(&model, m, &opts, &device)).collect::<Result<_, _>>()?;
     let bytes = if !pairwise {
         let f = &features[0];
-        output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout or give -o FILE")?;
+        io::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout or give -o FILE")?;
         f.to_npy().context("building the NPY")?
     } else {
         comparison(args, &motions, &features, &opts)?.into_bytes()
@@ -177,8 +152,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(io::write_output(args.common.output.as_deref(), &bytes)?)
 }
 
-/// `--joints` or `--frames` with DIFT: the matches of the target's joints or frames to the
-/// reference's, as JSON (or, with `--as-binding`, a binding).
 /// `--joints` or `--frames` with DIFT: the matches of the target's joints or frames to the
 /// reference's, as JSON (or, with `--as-binding`, a binding).
 fn comparison(args: &Args, motions: &[Clip], features: &[DiftFeatures], opts: &DiftOptions) -> anyhow::Result<String> {
@@ -189,24 +162,23 @@ fn comparison(args: &Args, motions: &[Clip], features: &[DiftFeatures], opts: &D
     Ok(match (args.joints, args.as_binding) {
         (true, true) => report::joint_binding(reference, target, features, args.bind_rate.unwrap_or(report::DIFT_BIND_RATE))?,
         (true, false) => report::joint_matches(reference, target, features, settings),
-        (false, _) => report::frame_matches(reference, target, features, settings, args.align.into()),
+        (false, _) => report::frame_matches(reference, target, features, settings, args.align),
     })
 }
 
 /// `--joints` with the correspondence engine: no model, the same scores `--bind auto` uses.
 fn combined_joints(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
-    let motions = load_motions(inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
-    if motions.len() != inputs.len() {
-        bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
-    }
+    let motions = load_one_each(args, inputs)?;
     let (reference, target) = (&motions[0], &motions[1]);
     let text = if args.as_binding { report::combined_binding(reference, target, args.bind_rate)? } else { report::combined_joint_matches(reference, target)? };
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
-/// DIFT features of one loaded motion.
-fn features_of(model: &FrozenDenoiser, m: &Clip, opts: &DiftOptions, device: &Device) -> anyhow::Result<DiftFeatures> {
-    let prepared = dift::prepare(&model.info, &m.skeleton, &m.motion, &m.name)?;
-    let schedule = model.info.schedule();
-    dift::extract(&model.model, &schedule, &prepared.condition.condition(), &prepared.features, opts, device).with_context(|| m.name.clone())
+/// One motion per input file (an NPY batch holds several).
+fn load_one_each(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<Vec<Clip>> {
+    let motions = load_motions(inputs, &LoadOptions { skeleton: args.skeleton.as_deref(), from: None })?;
+    if motions.len() != inputs.len() {
+        bail!("{} motions in {} files: give one motion per file (an NPY batch holds several)", motions.len(), inputs.len());
+    }
+    Ok(motions)
 }

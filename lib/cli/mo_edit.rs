@@ -2,16 +2,17 @@
 //! only reads, calls `edit` and writes; the edits themselves live in `lib/edit`.
 
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips};
-use crate::cli::mo_metrics::{parse_ground, physics_options, GroundArg};
+use crate::cli::mo_metrics::Contact;
 use crate::cli::output::OutFormat;
 use crate::cli::{bounds, CommonOpts};
 use crate::edit::space::{Axes, SignedAxis, Units};
 use crate::edit::time::Span;
 use crate::edit::{self, EditError};
-use crate::io::{self, npy};
+use crate::io;
 use crate::motion::write::{motion_bytes, MotionFormat};
 use crate::motion::Clip;
 use crate::motion::Motion;
+use crate::repr::Features;
 use crate::skeleton::Skeleton;
 use anyhow::{anyhow, bail, Context};
 use std::path::{Path, PathBuf};
@@ -160,13 +161,8 @@ pub enum Command {
         /// Seconds of easing into and out of each contact.
         #[arg(long, value_name = "S", default_value_t = 0.1, value_parser = bounds::non_negative(60.0))]
         blend: f64,
-        /// Ground: 'zero', 'estimate' or a height (as mo-metrics physics).
-        #[arg(long, value_name = "G", default_value = "zero", value_parser = parse_ground)]
-        ground: GroundArg,
-        #[arg(long, value_name = "F", default_value_t = 0.05)]
-        contact_height: f64,
-        #[arg(long, value_name = "F", default_value_t = 0.5)]
-        contact_speed: f64,
+        #[command(flatten)]
+        contact: Contact,
     },
 }
 
@@ -264,14 +260,11 @@ fn edit_one(command: &Command, c: &Clip, verbose: bool) -> Result<(Skeleton, Mot
         }
         Command::Rename { normalise: true, .. } => Ok((edit::rename::normalise(s)?, m.clone())),
         Command::Rename { map, .. } => {
-            let path = map.as_deref().unwrap_or(Path::new("-"));
-            let text = io::read_input(path).map_err(|e| EditError::Invalid(format!("cannot read {}: {e}", io::display_name(path))))?;
-            let text = String::from_utf8_lossy(&text);
-            let pairs = edit::rename::parse_map(&text).map_err(|e| EditError::Invalid(format!("{}: {e}", io::display_name(path))))?;
+            let pairs = edit::rename::read_map(map.as_deref().unwrap_or(Path::new("-")))?;
             Ok((edit::rename::rename(s, &pairs)?, m.clone()))
         }
-        Command::FootLock { blend, ground, contact_height, contact_speed, .. } => {
-            let options = physics_options(*ground, *contact_height, *contact_speed).map_err(|e| EditError::Invalid(e.to_string()))?;
+        Command::FootLock { blend, contact, .. } => {
+            let options = contact.options().map_err(|e| EditError::Invalid(e.to_string()))?;
             let (out, report) = edit::foot_lock::foot_lock(s, m, &options, frames(*blend, m))?;
             if verbose {
                 for line in report.lines() {
@@ -302,18 +295,12 @@ fn write(args: &Args, mut skeleton: Skeleton, motion: Motion) -> anyhow::Result<
         (None, None) => OutFormat::Bvh,
     };
     let name = out.map_or_else(|| "<stdout>".to_string(), |p| p.display().to_string());
+    if matches!(format, OutFormat::Npy | OutFormat::Glb) {
+        io::refuse_terminal(out, if format == OutFormat::Npy { "NPY" } else { "binary glTF" }, "give -o FILE or redirect stdout")?;
+    }
     let bytes = match format {
-        OutFormat::Npy | OutFormat::Glb => {
-            io::refuse_terminal(out, if format == OutFormat::Npy { "NPY" } else { "binary glTF" }, "give -o FILE or redirect stdout")?;
-            if format == OutFormat::Glb {
-                motion_bytes(&skeleton, &motion, MotionFormat::Glb, &name)?
-            } else {
-                let f = crate::repr::m2m::encode(&motion);
-                npy::to_bytes(&[f.frames, f.joints, f.dims], &f.data).context("building the NPY")?
-            }
-        }
-        OutFormat::Gltf => motion_bytes(&skeleton, &motion, MotionFormat::Gltf, &name)?,
-        OutFormat::Bvh => motion_bytes(&skeleton, &motion, MotionFormat::Bvh, &name)?,
+        OutFormat::Npy => Features::batch_npy(&[crate::repr::m2m::encode(&motion)], false).context("building the NPY")?,
+        format => motion_bytes(&skeleton, &motion, format.motion(), &name)?,
     };
     Ok(io::write_output(out, &bytes)?)
 }

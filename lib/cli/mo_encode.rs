@@ -20,18 +20,18 @@
 //! atomically, and a failed write removes the outputs of the call already written, so an
 //! error never leaves a partial output.
 
-use crate::cli::load::{is_dash, read_skeleton, split_samples, FeatureDecoder};
-pub use crate::cli::load::{load_skeleton, DecodeFrom, MotionFormat};
+use crate::cli::load::{is_dash, read_skeleton, split_samples, FeatureDecoder, MotionFormat};
 use crate::cli::{output, CommonOpts};
 use crate::document::MotionInfo;
 use crate::io::{self, npy};
 use crate::motion::clip::Clip;
+use crate::repr::batch::PoseFrom;
 
 use crate::encode::{self, decode};
 use crate::input;
 use crate::motion::write;
-use crate::repr::anytop::{self, placements, NamedOverrides, Placement};
-use crate::repr::{m2m, Features};
+use crate::repr::anytop::{placements, NamedOverrides};
+use crate::repr::Features;
 use crate::sata;
 use anyhow::{bail, Context};
 use rayon::prelude::*;
@@ -105,6 +105,7 @@ EXAMPLES:
 /// given: the rest pose its rotations were learned against.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-encode", version, after_long_help = EXAMPLES)]
+#[command(group = clap::ArgGroup::new("latents").args(["latent", "decode_latent"]))]
 pub struct Args {
     /// BVH files to encode ('-' = stdin); with --decode or --decode-latent, one NPY file
     /// (default: stdin).
@@ -179,20 +180,20 @@ pub struct Args {
     /// 'positions' fits the rotations to the features' joint positions by inverse kinematics,
     /// for generated features whose positions and rotations disagree.
     #[arg(long, value_enum, value_name = "FROM", requires = "decode")]
-    pub from: Option<DecodeFrom>,
+    pub from: Option<PoseFrom>,
     /// anytop decoding: the NPY holds normalised features; undo it with --skeleton's statistics.
     #[arg(long, requires = "decode")]
     pub normalised: bool,
     /// Encode one BVH clip into per-frame latents of the latent model (SATA): NPY [frames - 1,
     /// latent], the same size for every skeleton.
-    #[arg(long, conflicts_with_all = ["decode", "decode_latent", "repr"])]
+    #[arg(long, conflicts_with_all = ["decode", "repr", "skeleton"], conflicts_with_all = RIG_FLAGS)]
     pub latent: bool,
     /// Decode latents (NPY [frames, latent] from --latent) onto --skeleton, any skeleton, as
     /// BVH.
-    #[arg(long, requires = "skeleton", conflicts_with_all = ["decode", "repr"])]
+    #[arg(long, requires = "skeleton", conflicts_with_all = ["decode", "repr"], conflicts_with_all = RIG_FLAGS)]
     pub decode_latent: bool,
     /// The latent model: a directory from 'mo-train --arch sata' [default: the built-in one].
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", requires = "latents")]
     pub model: Option<PathBuf>,
     #[command(flatten)]
     pub common: CommonOpts,
@@ -207,30 +208,14 @@ pub enum Repr {
     M2m,
 }
 
-impl Repr {
-    pub fn name(self) -> &'static str {
-        match self {
-            Repr::Anytop => "anytop",
-            Repr::M2m => "m2m",
-        }
-    }
-
-    /// Feature dims per joint.
-    pub fn dims(self) -> usize {
-        match self {
-            Repr::Anytop => anytop::FEATURE_DIMS,
-            Repr::M2m => m2m::DIMS,
-        }
-    }
-}
+/// The flags that build or place an AnyTop rig, which latents do without (the latent model
+/// builds each clip's rig itself).
+const RIG_FLAGS: [&str; 9] = ["rest_pose", "face_joints", "body_axis", "feet", "require_contacts", "normalise", "stats", "emit_skeleton", "placement"];
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     if args.latent || args.decode_latent {
         return latent(args);
-    }
-    if args.model.is_some() {
-        bail!("--model belongs to --latent and --decode-latent");
     }
     refuse_anytop_flags(args)?;
     check_stdin(args)?;
@@ -243,21 +228,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 /// `--latent` / `--decode-latent`: one clip to latents, or latents to a BVH on --skeleton.
 fn latent(args: &Args) -> anyhow::Result<()> {
-    let given = [
-        (args.rest_pose.is_some(), "--rest-pose"),
-        (args.face_joints.is_some(), "--face-joints"),
-        (args.body_axis.is_some(), "--body-axis"),
-        (args.feet.is_some(), "--feet"),
-        (args.require_contacts, "--require-contacts"),
-        (args.normalise, "--normalise"),
-        (args.stats.is_some(), "--stats"),
-        (args.emit_skeleton.is_some(), "--emit-skeleton"),
-        (args.placement.is_some(), "--placement"),
-        (args.latent && args.skeleton.is_some(), "--skeleton (with --latent: the clip carries its skeleton)"),
-    ];
-    if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
-        bail!("{flag} does not apply to latents: the latent model builds each clip's rig itself");
-    }
     let dash = args.inputs.iter().filter(|p| is_dash(p)).count() + usize::from(args.skeleton.as_deref().is_some_and(is_dash));
     if dash > 1 || (args.decode_latent && args.inputs.is_empty() && args.skeleton.as_deref().is_some_and(is_dash)) {
         bail!("stdin ('-') can be read only once");
@@ -266,10 +236,10 @@ fn latent(args: &Args) -> anyhow::Result<()> {
     let model = sata::clips::frozen_or_default(args.model.as_deref(), &device)?;
     let bytes = if args.latent {
         let [input] = args.inputs.as_slice() else { bail!("--latent encodes one BVH clip, {} given", args.inputs.len()) };
-        let clip = super::latent::read_source(input, &model, &device)?;
+        let clip = sata::clips::SourceClip::read(input, &crate::cli::load::gltf_options(), &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &clip.name, &clip.skeleton, args.common.quiet)?;
         let latents = clip.encode(&model, &device)?;
-        output::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
+        io::refuse_terminal(args.common.output.as_deref(), "binary NPY", "redirect stdout or give -o FILE")?;
         sata::clips::latents_npy(&latents).context("building the NPY")?
     } else {
         let input = match args.inputs.as_slice() {
@@ -277,7 +247,7 @@ fn latent(args: &Args) -> anyhow::Result<()> {
             [one] => one.clone(),
             more => bail!("--decode-latent reads one NPY of latents, {} given", more.len()),
         };
-        let latents = super::latent::read_latents(&input)?;
+        let latents = sata::clips::read_latents(&input)?;
         let skeleton = args.skeleton.as_deref().context("--decode-latent needs --skeleton")?;
         let target = sata::clips::Target::new(read_skeleton(skeleton)?, &model, &device)?;
         super::ood::Known::latent(args.model.as_deref(), &model.rigs)?.warn("mo-encode", &target.file.name, &target.file.skeleton, args.common.quiet)?;
@@ -346,7 +316,7 @@ fn load_clip(path: &Path, frames: Option<usize>) -> anyhow::Result<(Clip, Option
 
 fn encode(args: &Args) -> anyhow::Result<()> {
     check_outputs(args)?;
-    output::refuse_terminal(args.common.output.as_deref(), "a binary NPY", "use -o FILE.npy or a pipe")?;
+    io::refuse_terminal(args.common.output.as_deref(), "a binary NPY", "use -o FILE.npy or a pipe")?;
     // Clips in parallel, results in argument order; the first failing argument is reported.
     let results: Vec<anyhow::Result<(Clip, Option<MotionInfo>)>> = args.inputs.par_iter().map(|p| load_clip(p, None)).collect();
     let (clips, infos): (Vec<Clip>, Vec<Option<MotionInfo>>) = results.into_iter().collect::<anyhow::Result<Vec<_>>>()?.into_iter().unzip();
@@ -362,27 +332,15 @@ fn encode(args: &Args) -> anyhow::Result<()> {
 /// One NPY of the clips' features, checked finite first.
 fn npy_bytes(clips: &[Clip], features: &[Features]) -> anyhow::Result<Vec<u8>> {
     encode::check_finite(clips, features)?;
-    output::features_npy(features, false)
+    Features::batch_npy(features, false).context("building the NPY")
 }
 
 /// At most one output on stdout, and no file named for two outputs.
 fn check_outputs(args: &Args) -> anyhow::Result<()> {
-    let outputs = [
-        ("-o", args.common.output.clone().or_else(|| Some(PathBuf::from("-")))),
-        ("--stats", args.stats.clone()),
-        ("--emit-skeleton", args.emit_skeleton.clone()),
-        ("--placement", args.placement.clone()),
-    ];
-    let given: Vec<(&str, PathBuf)> = outputs.into_iter().filter_map(|(flag, p)| Some((flag, p?))).collect();
-    for (i, (flag, path)) in given.iter().enumerate() {
-        if let Some((other, _)) = given[..i].iter().find(|(_, p)| p == path) {
-            if is_dash(path) {
-                bail!("{other} and {flag} both write to stdout: give one of them a file");
-            }
-            bail!("{other} and {flag} both write to {}", path.display());
-        }
-    }
-    Ok(())
+    let o = args.common.output.as_deref().unwrap_or(Path::new("-"));
+    let given = [("--stats", &args.stats), ("--emit-skeleton", &args.emit_skeleton), ("--placement", &args.placement)];
+    let outputs: Vec<(&str, &Path)> = [("-o", o)].into_iter().chain(given.iter().filter_map(|(flag, p)| Some((*flag, p.as_deref()?)))).collect();
+    Ok(io::output::distinct(&outputs)?)
 }
 
 fn encode_m2m(args: &Args, clips: &[Clip]) -> anyhow::Result<()> {
@@ -461,13 +419,6 @@ fn overrides(args: &Args) -> NamedOverrides {
     NamedOverrides { face_joints: args.face_joints.clone(), body_axis: args.body_axis.clone(), feet: args.feet.clone() }
 }
 
-/// One placement per sample, from a `--placement` file.
-fn read_placements(path: &Path, samples: usize, npy_name: &str) -> anyhow::Result<Vec<Placement>> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read placements {name}"))?;
-    placements::from_json(&bytes, &name, samples, npy_name).map_err(anyhow::Error::msg)
-}
-
 fn decode(args: &Args) -> anyhow::Result<()> {
     let input = match args.inputs.as_slice() {
         [] => PathBuf::from("-"),
@@ -489,11 +440,11 @@ fn decode(args: &Args) -> anyhow::Result<()> {
             let section = arg.record_with(rest_pose.as_ref(), &overrides(args), args.normalised)?;
             let stats = decode::normalisation(section.stats, args.normalised, &arg.name)?;
             let placements = match args.placement.as_deref() {
-                Some(p) => read_placements(p, samples.len(), &name)?,
+                Some(p) => placements::read(p, samples.len(), &name).map_err(anyhow::Error::msg)?,
                 None => vec![section.rig.rest_placement(); samples.len()],
             };
             args.common.say("mo-encode").info(format_args!("rig: {}", section.rig.describe(skeleton)));
-            FeatureDecoder::AnyTop { rig: Box::new(section.rig), stats, placements, from: args.from.unwrap_or(DecodeFrom::Rotations).into() }
+            FeatureDecoder::AnyTop { rig: Box::new(section.rig), stats, placements, from: args.from.unwrap_or(PoseFrom::Rotations) }
         }
     };
 

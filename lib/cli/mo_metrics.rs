@@ -6,13 +6,14 @@
 
 use crate::binding::Binding;
 use crate::cli::bounds;
-use crate::cli::load::{expand_inputs, load_motions, read_skeleton, DecodeFrom, LoadOptions};
+use crate::cli::load::{expand_inputs, load_motions, read_skeleton, LoadOptions};
 use crate::cli::CommonOpts;
 use crate::io;
 use crate::metrics::generation::GenerationOptions;
 use crate::metrics::physics::{Ground, PhysicsOptions};
 use crate::metrics::{checks, report};
 use crate::motion::Clip;
+use crate::repr::batch::PoseFrom;
 use anyhow::{bail, Context};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -60,8 +61,8 @@ pub struct Args {
     #[arg(long, value_name = "PATH", global = true)]
     pub skeleton: Option<PathBuf>,
     /// AnyTop features: pose from their rotations or (generated clips) their positions by IK.
-    #[arg(long, value_enum, value_name = "FROM", default_value_t = DecodeFrom::Rotations, global = true)]
-    pub from: DecodeFrom,
+    #[arg(long, value_enum, value_name = "FROM", default_value_t = PoseFrom::Rotations, global = true)]
+    pub from: PoseFrom,
     #[command(flatten)]
     pub common: CommonOpts,
 }
@@ -203,44 +204,28 @@ pub enum Command {
         /// Motion files or directories.
         #[arg(value_name = "INPUT", default_value = "-")]
         inputs: Vec<PathBuf>,
-        /// Ground: 'zero' (y = 0), 'estimate' (lowest foot height over the clip) or a height.
-        #[arg(long, value_name = "G", default_value = "zero", value_parser = parse_ground)]
-        ground: GroundArg,
-        /// Contact height threshold, as a fraction of the skeleton's size.
-        #[arg(long, value_name = "F", default_value_t = 0.05, allow_negative_numbers = true)]
-        contact_height: f64,
-        /// Contact speed threshold, as a fraction of the skeleton's size per second.
-        #[arg(long, value_name = "F", default_value_t = 0.5, allow_negative_numbers = true)]
-        contact_speed: f64,
+        #[command(flatten)]
+        contact: Contact,
     },
 }
 
-/// `--ground`, kept as a clap value.
-#[derive(Clone, Copy, Debug)]
-pub enum GroundArg {
-    Zero,
-    Estimate,
-    Height(f64),
+/// Where the ground is and when a foot touches it (`mo-metrics physics`, `mo-edit foot-lock`).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct Contact {
+    /// Ground: 'zero' (y = 0), 'estimate' (lowest foot height over the clip) or a height.
+    #[arg(long, value_name = "G", default_value = "zero")]
+    ground: Ground,
+    /// Contact height threshold, as a fraction of the skeleton's size.
+    #[arg(long, value_name = "F", default_value_t = 0.05, allow_negative_numbers = true)]
+    contact_height: f64,
+    /// Contact speed threshold, as a fraction of the skeleton's size per second.
+    #[arg(long, value_name = "F", default_value_t = 0.5, allow_negative_numbers = true)]
+    contact_speed: f64,
 }
 
-pub fn parse_ground(s: &str) -> Result<GroundArg, String> {
-    match s {
-        "zero" => Ok(GroundArg::Zero),
-        "estimate" => Ok(GroundArg::Estimate),
-        h => match h.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(GroundArg::Height(v)),
-            _ => Err(format!("expected zero, estimate or a height, found '{s}'")),
-        },
-    }
-}
-
-impl GroundArg {
-    fn ground(self) -> Ground {
-        match self {
-            GroundArg::Zero => Ground::Zero,
-            GroundArg::Estimate => Ground::Estimate,
-            GroundArg::Height(h) => Ground::Height(h),
-        }
+impl Contact {
+    pub fn options(&self) -> Result<PhysicsOptions, crate::metrics::MetricError> {
+        PhysicsOptions::new(self.ground, self.contact_height, self.contact_speed)
     }
 }
 
@@ -248,15 +233,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     let started = std::time::Instant::now();
     let report = match &args.command {
-        Command::Physics { inputs, ground, contact_height, contact_speed } => {
-            let opts = physics_options(*ground, *contact_height, *contact_speed)?;
-            run_physics(args, inputs, &opts)?
+        Command::Physics { inputs, contact } => {
+            let opts = contact.options()?;
+            report::physics_report(&load(args, inputs)?, &opts)?
         }
         Command::Reconstruction { reference, result, height } => run_reconstruction(args, reference, result, *height)?,
         Command::Transfer { source, result, binding, examples, seconds, fid_window } => {
             run_transfer(args, source, result, binding.as_deref(), examples, *seconds, *fid_window)?
         }
-        Command::Aggregate { reports } => run_aggregate(reports)?,
+        Command::Aggregate { reports } => report::aggregate_report(&report::read_reports(reports)?)?,
         Command::Ood { skeletons, model, latent } => run_ood(args, skeletons, model.as_deref(), *latent)?,
         Command::Generation { gt, generated, window, threshold, min_segment } => {
             let opts =
@@ -286,13 +271,6 @@ fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: boo
     Ok(known.reference.report(&known.model, &skeletons, args.common.verbose)?)
 }
 
-pub fn physics_options(ground: GroundArg, contact_height: f64, contact_speed: f64) -> anyhow::Result<PhysicsOptions> {
-    if !(contact_height.is_finite() && contact_height > 0.0) || !(contact_speed.is_finite() && contact_speed > 0.0) {
-        bail!("--contact-height and --contact-speed must be positive numbers");
-    }
-    Ok(PhysicsOptions { contact_height, contact_speed, ground: ground.ground() })
-}
-
 fn load(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<Vec<Clip>> {
     let files = expand_inputs(inputs)?;
     let options = LoadOptions { skeleton: args.skeleton.as_deref(), from: Some(args.from) };
@@ -309,10 +287,6 @@ fn load_one(args: &Args, path: &Path) -> anyhow::Result<Clip> {
         bail!("{}: expected one motion, found {} (an NPY batch?)", io::display_name(path), loaded.len());
     }
     Ok(loaded.remove(0))
-}
-
-fn run_physics(args: &Args, inputs: &[PathBuf], opts: &PhysicsOptions) -> anyhow::Result<Value> {
-    Ok(report::physics_report(&load(args, inputs)?, opts)?)
 }
 
 fn run_reconstruction(args: &Args, reference: &Path, result: &Path, height: Option<f64>) -> anyhow::Result<Value> {
@@ -342,14 +316,8 @@ fn run_transfer(
     let results = load(args, results)?;
     let target = &results[0];
     checks::one_target(&results)?;
-    let pairs: Vec<(usize, usize)> = match binding {
-        Some(path) => {
-            let name = io::display_name(path);
-            let text =
-                String::from_utf8(io::read_input(path).with_context(|| format!("cannot read {name}"))?).map_err(|_| anyhow::anyhow!("{name}: not UTF-8"))?;
-            let b = Binding::from_json(&text, &name)?;
-            b.resolve(&name, &src.skeleton, &src.name, &target.skeleton, &target.name)?
-        }
+    let pairs = match binding {
+        Some(path) => Binding::read_resolved(path, &src, target)?.0,
         None => report::same_name_pairs(&src, target),
     };
     checks::some_pairs(&src, target, &pairs)?;
@@ -369,14 +337,4 @@ fn run_generation(args: &Args, gt: &[PathBuf], generated: &[PathBuf], opts: &Gen
         None => checks::generation_rig(&gt[0])?,
     };
     Ok(report::generation_report(&gt, &gen, &section, opts)?)
-}
-
-fn run_aggregate(paths: &[PathBuf]) -> anyhow::Result<Value> {
-    let mut reports = Vec::new();
-    for path in paths {
-        let (name, bytes) = io::read_named(path)?;
-        let v: Value = serde_json::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{name}: not JSON: {e}"))?;
-        reports.push((name, v));
-    }
-    Ok(report::aggregate_report(&reports)?)
 }

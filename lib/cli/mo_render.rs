@@ -3,17 +3,16 @@
 //! the sheet, GIF and HTML renderers. Every picture is drawn in memory before any file is
 //! written, so a bad input or option never leaves a partial or a stale-mixed set of outputs.
 
-use crate::cli::load::{expand_inputs, is_dash, load_motions, DecodeFrom, LoadOptions};
+use crate::cli::load::{expand_inputs, is_dash, load_motions, LoadOptions};
 use crate::cli::CommonOpts;
 use crate::io;
 use crate::render::camera::Framing;
-use crate::render::gif::{render_gif, GifOptions};
-use crate::render::html::{render_html, HtmlOptions};
 use crate::render::labels::{self, FrameLabels, JointLabels};
-use crate::render::sheet::{render_sheet, SheetOptions};
-use crate::render::{Legend, Track, View};
+use crate::render::picture::{parse_range, parse_size, Look, Picture as Kind};
+use crate::render::{Track, View};
+use crate::repr::batch::PoseFrom;
 use anyhow::bail;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 const EXAMPLES: &str = "\
 EXAMPLES:
@@ -75,8 +74,8 @@ pub struct Args {
     pub skeleton: Option<PathBuf>,
     /// AnyTop features: pose from their rotations (exact for encoded clips) or their positions
     /// (inverse kinematics, for generated clips).
-    #[arg(long, value_enum, value_name = "FROM", default_value_t = DecodeFrom::Rotations)]
-    pub from: DecodeFrom,
+    #[arg(long, value_enum, value_name = "FROM", default_value_t = PoseFrom::Rotations)]
+    pub from: PoseFrom,
     /// Camera: auto, side, front, top, or YAW,PITCH in degrees (yaw about +y, 0 = side; pitch > 0
     /// looks down).
     #[arg(long, value_name = "VIEW", default_value = "auto", value_parser = View::parse)]
@@ -110,47 +109,10 @@ pub struct Args {
     #[arg(long)]
     pub overlay: bool,
     /// HTML: initial playback speed.
-    #[arg(long, value_name = "X", default_value_t = 1.0)]
+    #[arg(long, value_name = "X", default_value_t = 1.0, value_parser = crate::cli::bounds::positive(100.0))]
     pub speed: f64,
     #[command(flatten)]
     pub common: CommonOpts,
-}
-
-/// The three kinds of picture.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    Sheet,
-    Gif,
-    Html,
-}
-
-fn parse_range(s: &str) -> Result<(Option<usize>, Option<usize>), String> {
-    let (a, b) = s.split_once(':').ok_or_else(|| format!("expected START:END, found '{s}'"))?;
-    let num = |t: &str| -> Result<Option<usize>, String> {
-        if t.trim().is_empty() {
-            Ok(None)
-        } else {
-            t.trim().parse().map(Some).map_err(|_| format!("'{t}' is not a frame number"))
-        }
-    };
-    let (start, end) = (num(a)?, num(b)?);
-    if let (Some(s0), Some(e)) = (start, end) {
-        if e <= s0 {
-            return Err(format!("the range {s} is empty (END is exclusive)"));
-        }
-    }
-    Ok((start, end))
-}
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) =
-        s.to_ascii_lowercase().split_once('x').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected WIDTHxHEIGHT, found '{s}'"))?;
-    let w: u32 = w.trim().parse().map_err(|_| format!("width '{w}' is not a whole number"))?;
-    let h: u32 = h.trim().parse().map_err(|_| format!("height '{h}' is not a whole number"))?;
-    if !(32..=4096).contains(&w) || !(32..=4096).contains(&h) {
-        return Err(format!("sizes must be within 32..4096 pixels, found {w}x{h}"));
-    }
-    Ok((w, h))
 }
 
 /// Where each picture goes (`None` = stdout).
@@ -163,7 +125,7 @@ fn outputs(args: &Args) -> anyhow::Result<Vec<(Kind, Option<PathBuf>)>> {
     }
     let o = args.common.output.as_ref();
     if o.is_some() || out.is_empty() {
-        let by_extension = o.filter(|p| !is_dash(p)).and_then(|p| kind_of_extension(p));
+        let by_extension = o.filter(|p| !is_dash(p)).and_then(|p| Kind::of_path(p));
         let kind = match (args.format, by_extension) {
             (Some(k), _) => k,
             (None, Some(k)) => k,
@@ -186,34 +148,11 @@ fn outputs(args: &Args) -> anyhow::Result<Vec<(Kind, Option<PathBuf>)>> {
     Ok(out)
 }
 
-fn kind_of_extension(p: &Path) -> Option<Kind> {
-    match p.extension()?.to_str()?.to_ascii_lowercase().as_str() {
-        "png" => Some(Kind::Sheet),
-        "gif" => Some(Kind::Gif),
-        "html" | "htm" => Some(Kind::Html),
-        _ => None,
-    }
-}
-
-fn read_text(path: &Path) -> anyhow::Result<String> {
-    let (name, bytes) = io::read_named(path)?;
-    String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))
-}
-
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
-    if !(args.speed.is_finite() && args.speed > 0.0 && args.speed <= 100.0) {
-        bail!("--speed must be within (0, 100], found {}", args.speed);
-    }
     let outputs = outputs(args)?;
-    let joint_labels = match &args.joint_labels {
-        Some(p) => Some((JointLabels::from_json(&read_text(p)?, &io::display_name(p))?, io::display_name(p))),
-        None => None,
-    };
-    let frame_labels = match &args.frame_labels {
-        Some(p) => Some((FrameLabels::from_json(&read_text(p)?, &io::display_name(p))?, io::display_name(p))),
-        None => None,
-    };
+    let joint_labels = args.joint_labels.as_deref().map(JointLabels::read).transpose()?;
+    let frame_labels = args.frame_labels.as_deref().map(FrameLabels::read).transpose()?;
 
     let inputs = expand_inputs(&args.inputs)?;
     let options = LoadOptions { skeleton: args.skeleton.as_deref(), from: Some(args.from) };
@@ -235,10 +174,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     )?;
 
     let framing = if args.fixed_camera { Framing::Fixed } else { Framing::Follow };
+    let (every, columns, rows) = (args.every.map(|k| k as usize), args.columns as usize, args.rows as usize);
+    let look = Look { view: args.view, framing, every, columns, rows, size: args.size, speed: args.speed, overlay: args.overlay };
     let mut pictures: Vec<(Vec<u8>, Option<PathBuf>, Kind)> = Vec::new();
     for (kind, path) in outputs {
-        let bytes = draw(kind, &tracks, &legend, framing, args)?;
-        pictures.push((bytes, path, kind));
+        pictures.push((kind.draw(&tracks, &legend, &look)?, path, kind));
     }
     // All pictures or none.
     io::write_all(&pictures.iter().map(|(b, p, _)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?;
@@ -247,33 +187,4 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.common.say("mo-render").info(format_args!("wrote {kind:?} ({} bytes, {} motion(s)) to {target}", bytes.len(), tracks.len()));
     }
     Ok(())
-}
-
-fn draw(kind: Kind, tracks: &[Track], legend: &Legend, framing: Framing, args: &Args) -> anyhow::Result<Vec<u8>> {
-    Ok(match kind {
-        Kind::Sheet => {
-            let mut o = SheetOptions { view: args.view, framing, columns: args.columns as usize, max_rows: args.rows as usize, ..SheetOptions::default() };
-            if let Some(k) = args.every {
-                o.every = k as usize;
-            }
-            if let Some((w, h)) = args.size {
-                o.cell_width = w;
-                o.cell_height = h;
-            }
-            render_sheet(tracks, legend, &o)?
-        }
-        Kind::Gif => {
-            let mut o = GifOptions { view: args.view, framing, ..GifOptions::default() };
-            if let Some((w, h)) = args.size {
-                o.panel_width = w;
-                o.panel_height = h;
-            }
-            render_gif(tracks, legend, &o)?
-        }
-        Kind::Html => {
-            let title = tracks.iter().map(|t| t.title.as_str()).collect::<Vec<_>>().join(" | ");
-            let o = HtmlOptions { title, speed: args.speed, overlay: args.overlay, ..HtmlOptions::default() };
-            render_html(tracks, legend, &o)?.into_bytes()
-        }
-    })
 }

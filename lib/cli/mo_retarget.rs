@@ -3,8 +3,6 @@
 //! calls `retarget::retarget_samples`, and writes BVH (or NPY) on the target skeleton. All
 //! outputs are built in memory first, so a failure never leaves some files written.
 
-use crate::binding::auto;
-use crate::binding::{Binding, JointMap};
 use crate::cli::bounds;
 use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton};
 use crate::cli::output::{self, OutFormat};
@@ -16,7 +14,7 @@ use crate::motion::Motion;
 use crate::repr::m2m;
 use crate::retarget::{self, BoundRotation, Repr, RootMotion, Settings};
 use anyhow::{bail, Context};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 const EXAMPLES: &str = "\
@@ -122,13 +120,13 @@ pub struct Args {
     pub pyramid: Option<f64>,
     /// Matching features (paper table 4).
     #[arg(long, value_enum)]
-    pub repr: Option<ReprArg>,
+    pub repr: Option<Repr>,
     /// How bound joints take the source's rotation.
     #[arg(long, value_enum)]
-    pub bound_rotation: Option<BoundArg>,
+    pub bound_rotation: Option<BoundRotation>,
     /// Where the root trajectory comes from.
     #[arg(long, value_enum)]
-    pub root_motion: Option<RootArg>,
+    pub root_motion: Option<RootMotion>,
     /// After synthesis, overwrite the bound channels with the source's (the paper's "directly
     /// copy", the reference's copy mode): bound joints follow the source exactly.
     #[arg(long)]
@@ -144,31 +142,6 @@ pub struct Args {
 pub enum Method {
     M2m,
     Latent,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ReprArg {
-    Rotation,
-    Velocity,
-    Position,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BoundArg {
-    /// Copy the source's local rotations (the reference's behaviour).
-    Local,
-    /// Rotate bound bones so their directions follow the source's, relative to each rest pose.
-    Aligned,
-    /// Match the source's world rotations.
-    World,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RootArg {
-    /// From the examples' patches (the reference's behaviour).
-    Examples,
-    /// The source's trajectory, scaled to the target's size.
-    Source,
 }
 
 /// `--method latent`: encode the source with the latent model, decode onto the target skeleton.
@@ -200,7 +173,7 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let device = candle_core::Device::Cpu;
     let model = crate::sata::clips::frozen_or_default(args.model.as_deref(), &device)?;
-    let source = super::latent::read_source(&args.source, &model, &device)?;
+    let source = crate::sata::clips::SourceClip::read(&args.source, &crate::cli::load::gltf_options(), &model, &device)?;
     let target = crate::sata::clips::Target::new(read_skeleton(&target_path)?, &model, &device)?;
     let known = super::ood::Known::latent(args.model.as_deref(), &model.rigs)?;
     for (name, skeleton) in [(&source.name, &source.skeleton), (&target.file.name, &target.file.skeleton)] {
@@ -225,24 +198,17 @@ fn run_latent(args: &Args) -> anyhow::Result<()> {
 }
 
 fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Settings> {
-    let mut s = Settings { seed: args.common.seed, copy_bound: args.copy_bound, ..Settings::default() };
-    if let Some(p) = args.patch {
-        if p < 1 {
-            bail!("--patch must be at least 1 frame");
-        }
-        s.patch = p;
-    }
+    // --patch, --steps and --frames are at least 1 (clap's `bounds::count`).
+    let d = Settings::default();
+    let (repr, bound_rotation, root_motion) =
+        (args.repr.unwrap_or(d.repr), args.bound_rotation.unwrap_or(d.bound_rotation), args.root_motion.unwrap_or(d.root_motion));
+    let (patch, steps) = (args.patch.unwrap_or(d.patch), args.steps.unwrap_or(d.steps));
+    let mut s = Settings { seed: args.common.seed, copy_bound: args.copy_bound, patch, steps, repr, bound_rotation, root_motion, ..d };
     if let Some(a) = args.alpha {
         if !(0.0..=1.0).contains(&a) {
             bail!("--alpha must be within 0..1, found {a}");
         }
         s.alpha = a as f32;
-    }
-    if let Some(l) = args.steps {
-        if l < 1 {
-            bail!("--steps must be at least 1");
-        }
-        s.steps = l;
     }
     if let Some(p) = args.pyramid {
         if !(p > 0.0 && p < 1.0) {
@@ -250,28 +216,7 @@ fn settings(args: &Args, fps: f64, source_frames: usize) -> anyhow::Result<Setti
         }
         s.pyramid = p;
     }
-    if let Some(r) = args.repr {
-        s.repr = match r {
-            ReprArg::Rotation => Repr::Rotation,
-            ReprArg::Velocity => Repr::Velocity,
-            ReprArg::Position => Repr::Position,
-        };
-    }
-    if let Some(b) = args.bound_rotation {
-        s.bound_rotation = match b {
-            BoundArg::Local => BoundRotation::Local,
-            BoundArg::Aligned => BoundRotation::Aligned,
-            BoundArg::World => BoundRotation::World,
-        };
-    }
-    if let Some(r) = args.root_motion {
-        s.root_motion = match r {
-            RootArg::Examples => RootMotion::Examples,
-            RootArg::Source => RootMotion::Source,
-        };
-    }
     s.frames = match (args.frames, args.seconds) {
-        (Some(0), _) => bail!("--frames must be at least 1"),
         (Some(n), _) => Some(n),
         (None, Some(sec)) => Some(bounds::frames_for_seconds(sec, fps).map_err(anyhow::Error::msg)?),
         (None, None) => None,
@@ -305,7 +250,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let outputs = output_paths(args, count)?;
     let (source, examples) = read_inputs(args)?;
     let first = &examples[0];
-    let (map, binding) = binding_for(bind, &source, first, args.bind_rate)?;
+    let (map, binding) = crate::binding::clips::binding_for(bind, &source, first, args.bind_rate)?;
     if args.emit_binding {
         return Ok(io::write_output(outputs[0].as_deref(), binding.to_json().as_bytes())?);
     }
@@ -329,19 +274,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     // Everything to bytes first, then write all samples or none.
     let t1 = Instant::now();
-    let files: Vec<(Option<PathBuf>, Vec<u8>)> = match args.format {
+    match args.format {
         OutFormat::Npy => {
-            output::refuse_terminal(outputs[0].as_deref(), "NPY", "give -o FILE or redirect stdout")?;
             let features: Vec<_> = results.iter().map(|r| m2m::encode(&r.motion)).collect();
-            vec![(outputs[0].clone(), output::features_npy(&features, false)?)]
+            output::write_npy(outputs[0].as_deref(), &features, false, "give -o FILE or redirect stdout")?;
         }
-        _ => results
-            .iter()
-            .zip(&outputs)
-            .map(|(r, out)| Ok((out.clone(), motion_file(&first.skeleton, &r.motion, out.as_deref(), args.format.motion())?)))
-            .collect::<anyhow::Result<_>>()?,
-    };
-    output::write_all(&files)?;
+        _ => output::write_motions(&first.skeleton, results.iter().map(|r| &r.motion), &outputs, args.format.motion())?,
+    }
     let written = t1.elapsed();
 
     if args.report && !args.common.quiet {
@@ -359,14 +298,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 /// Where the samples go: one numbered file each, one file (a binding, an NPY batch), or stdout.
 fn output_paths(args: &Args, count: usize) -> anyhow::Result<Vec<Option<PathBuf>>> {
-    Ok(match args.common.output.as_deref() {
-        Some(p) if !is_dash(p) && !args.emit_binding && !(args.format == OutFormat::Npy) => output::numbered(p, count)?.into_iter().map(Some).collect(),
-        Some(p) if !is_dash(p) => vec![Some(p.to_path_buf())],
-        _ if count > 1 && args.format != OutFormat::Npy && !args.emit_binding => {
-            bail!("{count} samples need a numbered output path such as -o 'out_{{i}}.bvh' (or --format npy for one batch)")
-        }
-        _ => vec![None],
-    })
+    if args.emit_binding || args.format == OutFormat::Npy {
+        return Ok(vec![args.common.output.clone().filter(|p| !is_dash(p))]);
+    }
+    io::numbered_outputs(args.common.output.as_deref(), count, "samples", "(or --format npy for one batch)").map_err(anyhow::Error::msg)
 }
 
 /// The source and the target's example clips, each at least two frames long.
@@ -379,20 +314,4 @@ fn read_inputs(args: &Args) -> anyhow::Result<(Clip, Vec<Clip>)> {
     let examples = read_example_clips(&args.targets, "mo-retarget", "target clips")?;
     retarget::clips::check_lengths(&source, &examples)?;
     Ok((source, examples))
-}
-
-/// The binding of `--bind`: computed (`auto`) or read from a file, as joint pairs and as the
-/// document `--emit-binding` writes.
-fn binding_for(bind: &str, source: &Clip, first: &Clip, rate: Option<f64>) -> anyhow::Result<(JointMap, Binding)> {
-    if bind == "auto" {
-        let choices = crate::binding::clips::bind_auto(source, first, rate)?;
-        let binding = auto::to_binding(&choices, &source.skeleton, &source.name, &first.skeleton, &first.name);
-        return Ok((choices.iter().map(|c| (c.source, c.target)).collect(), binding));
-    }
-    let path = Path::new(bind);
-    let name = io::display_name(path);
-    let text = String::from_utf8(io::read_input(path).with_context(|| format!("cannot read binding {name}"))?)
-        .map_err(|_| anyhow::anyhow!("{name}: not UTF-8 text"))?;
-    let binding = Binding::from_json(&text, &name)?;
-    Ok((binding.resolve(&name, &source.skeleton, &source.name, &first.skeleton, &first.name)?, binding))
 }

@@ -5,11 +5,11 @@ use crate::cli::load::read_skeleton;
 use crate::cli::{output, CommonOpts};
 use crate::diffusion::checkpoint;
 use crate::diffusion::condition::{SkeletonCondition, StatsSource};
-use crate::diffusion::edit::{self, KeepMask};
-use crate::diffusion::keep::{Kept, Reference};
-use crate::diffusion::sample::{sample, PostProcess, SampleOptions};
+use crate::diffusion::edit;
+use crate::diffusion::keep::Reference;
+use crate::diffusion::sample::{sample, PostProcess, SampleOptions, DEFAULT_BLEND_SECONDS, DEFAULT_SMOOTH_HZ};
 use crate::diffusion::Sampler;
-use crate::io;
+use crate::motion::write::MotionFormat;
 use crate::repr::anytop::{AnyTopRig, IkOptions, Placement};
 use crate::repr::Features;
 use anyhow::{bail, Context};
@@ -30,13 +30,6 @@ EXAMPLES:
     mo-sample --examples gen_0.bvh --reference gen_1.bvh --keep-frames 0-29,170-199 > ib.npy
     mo-sample examples/data/dragon.bvh --model my_dragon -n 2 --frames 60 --bvh 'my_dragon_{i}.bvh'";
 
-/// The default `--smooth`: 7 Hz, the lowest whole cutoff at which the post-process keeps real
-/// motion: on the bundled creatures and real clips (dog, chicken, flamingo, monkey, crab, a
-/// LAFAN1 walk) it changes motion energy by at most 7% (the wing beats of the bird; 4 Hz took
-/// 28% off them and 9% off the dog), `tests/it/post_process.rs`. What it leaves of the model's
-/// jitter is the model's to fix (models/zoo-small/MODEL_CARD.md).
-pub const DEFAULT_SMOOTH_HZ: f64 = 7.0;
-
 /// Frames per sample (`--frames`, `--seconds`): the denoiser attends over all frames at once.
 pub const MAX_SAMPLE_FRAMES: u64 = 10_000;
 
@@ -47,9 +40,6 @@ pub fn sample_frames(seconds: f64, fps: f64) -> anyhow::Result<usize> {
         n => Ok(n),
     }
 }
-
-/// The default `--blend`: half a second (15 frames at 30 fps), the order of a step.
-pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
 
 /// Generate motion for a skeleton with a trained diffusion model (AnyTop), or from a few clips
 /// of it with no model at all (--examples, GenMM).
@@ -144,8 +134,8 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=100))]
     pub steps: u64,
     /// Sampler.
-    #[arg(long, value_enum, default_value_t = SamplerArg::Ddim)]
-    pub sampler: SamplerArg,
+    #[arg(long, value_enum, default_value_t = Sampler::Ddim)]
+    pub sampler: Sampler,
     /// Write BVH files instead of NPY ('{i}' becomes the sample index); named .glb or .gltf: glTF.
     #[arg(long, value_name = "PATTERN")]
     pub bvh: Option<PathBuf>,
@@ -183,21 +173,6 @@ pub struct Args {
     pub common: CommonOpts,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SamplerArg {
-    Ddpm,
-    Ddim,
-}
-
-impl SamplerArg {
-    fn sampler(self) -> Sampler {
-        match self {
-            SamplerArg::Ddpm => Sampler::Ddpm,
-            SamplerArg::Ddim => Sampler::Ddim,
-        }
-    }
-}
-
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     if !args.examples.is_empty() {
@@ -222,7 +197,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             if args.keep_frames.is_none() && args.keep_joints.is_none() {
                 bail!("--reference needs --keep-frames RANGES or --keep-joints LIST (what to keep of it)");
             }
-            Some(read_reference(path, &arg.name, skeleton, &section.rig)?)
+            Some(Reference::read(path, &crate::cli::load::gltf_options(), &arg.name, skeleton, &section.rig)?)
         }
         None => None,
     };
@@ -238,7 +213,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // joint and frame.
     let tokens = count as u128 * frames as u128 * skeleton.len() as u128;
     crate::budget::check(&format!("{count} samples of {frames} frames on {} joints", skeleton.len()), tokens, loaded.info.config.width * 4 * 4)?;
-    let mask = reference.as_ref().map(|r| keep_mask(args, r, skeleton, frames)).transpose()?;
+    let mask = reference.as_ref().map(|r| r.mask(args.keep_frames.as_deref(), args.keep_joints.as_deref(), skeleton, frames)).transpose()?;
 
     let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, section.stats.as_ref()).with_context(|| arg.name.clone())?;
     if condition.stats_source == StatsSource::Fallback && !args.common.quiet {
@@ -247,7 +222,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let cond = condition.condition();
     let post = PostProcess::new(args.smooth, args.blend, !args.no_plant_feet, fps, crate::cli::bounds::MAX_SECONDS)?;
     let schedule = loaded.info.schedule();
-    let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler: args.sampler.sampler(), seed: args.common.seed };
+    let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler: args.sampler, seed: args.common.seed };
     let started = std::time::Instant::now();
     let mut samples = match (&reference, &mask) {
         (Some(r), Some(mask)) => edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &r.features.padded_to(frames), mask, &device)?,
@@ -278,43 +253,10 @@ fn write_samples(
     skeleton: &crate::skeleton::Skeleton,
     placement: &Placement,
 ) -> anyhow::Result<()> {
-    match outputs {
-        Some(paths) => {
-            let mut files = Vec::with_capacity(paths.len());
-            for (i, (f, path)) in samples.iter().zip(paths).enumerate() {
-                let motion = rig.decode_ik(skeleton, f, placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"))?;
-                let bytes = crate::motion::write::motion_file(skeleton, &motion, Some(&path), crate::cli::load::MotionFormat::Bvh)?;
-                files.push((Some(path), bytes));
-            }
-            output::write_all(&files)
-        }
-        None => {
-            output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
-            Ok(io::write_output(args.common.output.as_deref(), &output::features_npy(samples, true)?)?)
-        }
-    }
-}
-
-/// Read and encode `--reference` on the rig of the skeleton being sampled.
-fn read_reference(
-    path: &std::path::Path,
-    skeleton_name: &str,
-    skeleton: &crate::skeleton::Skeleton,
-    rig: &crate::repr::anytop::AnyTopRig,
-) -> anyhow::Result<Reference> {
-    let name = io::display_name(path);
-    let bytes = io::read_input(path).with_context(|| format!("cannot read the reference {name}"))?;
-    // Parse errors say it is the reference; a bad skeleton's message names the file already.
-    let clip = crate::cli::load::clip_from_bytes(&bytes, &name, path).map_err(|e| match e {
-        e @ crate::motion::ClipError::Skeleton { .. } => anyhow::Error::new(e),
-        e => anyhow::Error::new(e).context(format!("the reference {name}")),
-    })?;
-    Ok(Reference::encode(clip, skeleton_name, skeleton, rig)?)
-}
-
-/// The cells `--keep-frames` and `--keep-joints` keep (`diffusion::keep`): frames must exist in
-/// both the output and the reference; joints are kept over every output frame the reference has.
-fn keep_mask(args: &Args, r: &Reference, skeleton: &crate::skeleton::Skeleton, frames: usize) -> anyhow::Result<KeepMask> {
-    let why = format!("the output has {frames} frames, the reference {} has {} frames of features", r.name, r.features.frames);
-    Ok(Kept::resolve(args.keep_frames.as_deref(), args.keep_joints.as_deref(), skeleton, frames, r.features.frames, &why)?.mask())
+    let Some(paths) = outputs else {
+        return output::write_npy(args.common.output.as_deref(), samples, true, "redirect stdout, or give -o FILE or --bvh PATTERN");
+    };
+    let decode = |(i, f): (usize, &Features)| rig.decode_ik(skeleton, f, placement, &IkOptions::default()).map_err(|e| anyhow::anyhow!("sample {i}: {e}"));
+    let motions = samples.iter().enumerate().map(decode).collect::<anyhow::Result<Vec<_>>>()?;
+    output::write_motions(skeleton, &motions, &paths.into_iter().map(Some).collect::<Vec<_>>(), MotionFormat::Bvh)
 }

@@ -8,7 +8,7 @@ use crate::cli::load::{is_dash, read_bvh_clip, read_example_clips, read_skeleton
 use crate::cli::output;
 use crate::diffusion::keep::Kept;
 use crate::genmm::{self, Keep, Settings};
-use crate::io;
+use crate::motion::write::MotionFormat;
 use crate::motion::Clip;
 use crate::repr::m2m;
 use anyhow::{bail, Context};
@@ -67,17 +67,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     match outputs {
         Some(paths) => {
-            let files = generated
-                .iter()
-                .zip(paths)
-                .map(|(g, p)| Ok((Some(p.clone()), crate::motion::write::motion_file(skeleton, &g.motion, Some(&p), crate::cli::load::MotionFormat::Bvh)?)))
-                .collect::<anyhow::Result<Vec<_>>>()?;
-            output::write_all(&files)?;
+            output::write_motions(skeleton, generated.iter().map(|g| &g.motion), &paths.into_iter().map(Some).collect::<Vec<_>>(), MotionFormat::Bvh)?
         }
         None => {
-            output::refuse_terminal(args.common.output.as_deref(), "NPY", "redirect stdout, or give -o FILE or --bvh PATTERN")?;
             let features: Vec<_> = generated.iter().map(|g| m2m::encode(&g.motion)).collect();
-            io::write_output(args.common.output.as_deref(), &output::features_npy(&features, true)?)?;
+            output::write_npy(args.common.output.as_deref(), &features, true, "redirect stdout, or give -o FILE or --bvh PATTERN")?;
         }
     }
     say.info(format_args!("total {:.3} s", started.elapsed().as_secs_f64()));

@@ -5,11 +5,11 @@
 //! writes JSON that `mo-render --frame-labels` reads.
 
 use crate::cli::bounds;
-use crate::cli::load::{is_dash, read_skeleton};
+use crate::cli::load::is_dash;
 use crate::cli::CommonOpts;
 use crate::diffusion::checkpoint;
 use crate::dift::DiftOptions;
-use crate::io::{self, npy};
+use crate::io;
 use crate::segment::input::{dift_features, raw_features, segment_input, window_frames, Input};
 use crate::segment::SegmentOptions;
 use anyhow::bail;
@@ -107,15 +107,6 @@ pub enum Features {
     Dift,
 }
 
-impl Features {
-    pub fn name(self) -> &'static str {
-        match self {
-            Features::Raw => "raw",
-            Features::Dift => "dift",
-        }
-    }
-}
-
 /// One feature vector per frame of `input` for `--features`, row t describing BVH frame t (rows
 /// may stop short of the last frames; `segment_input` gives those the last row's label; all rows
 /// the same length, finite). New feature kinds (DIFT) are one more `Features` variant and one
@@ -163,7 +154,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             started.elapsed().as_secs_f64()
         );
     }
-    let text = crate::segment::report::report(&input, args.features.name(), &options, args.common.seed, &result)?;
+    let features_name = clap::ValueEnum::to_possible_value(&args.features).expect("no variant is skipped");
+    let text = crate::segment::report::report(&input, features_name.get_name(), &options, args.common.seed, &result)?;
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
@@ -173,16 +165,5 @@ fn load(args: &Args) -> anyhow::Result<Input> {
     if is_dash(&args.input) && args.skeleton.as_deref().is_some_and(is_dash) {
         bail!("stdin ('-') can be read only once, but the input and --skeleton both read it");
     }
-    let (name, bytes) = io::read_named(&args.input)?;
-    let skeleton = match &args.skeleton {
-        Some(path) => Some(read_skeleton(path)?),
-        None => None,
-    };
-    if !npy::looks_like_npy(&args.input, &bytes) {
-        let clip = crate::cli::load::clip_from_bytes(&bytes, &name, &args.input)?;
-        drop(bytes);
-        return Ok(Input::from_clip(clip, skeleton)?);
-    }
-    let array = npy::from_bytes(&bytes, &name)?;
-    Ok(Input::from_npy(name, array, skeleton)?)
+    Ok(Input::read(&args.input, args.skeleton.as_deref(), &crate::cli::load::gltf_options())?)
 }

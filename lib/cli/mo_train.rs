@@ -6,14 +6,13 @@ use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, TrainSet};
 use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::embed::NameTable;
-use crate::nn::DenoiserConfig;
+use crate::nn::{DenoiserConfig, Preset};
 use crate::sata::trainer::{SataOptions, SataResume, SataTrainer};
 use crate::sata::SataConfig;
 use crate::skeleton::topology;
 use anyhow::{bail, Context};
 use candle_core::Device;
 use std::path::PathBuf;
-use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 const EXAMPLES: &str = "\
@@ -190,53 +189,20 @@ pub enum Arch {
     Sata,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Preset {
-    Tiny,
-    Small,
-    Paper,
-}
-
-impl Preset {
-    fn config(self) -> DenoiserConfig {
-        match self {
-            Preset::Tiny => DenoiserConfig::tiny(),
-            Preset::Small => DenoiserConfig::small(),
-            Preset::Paper => DenoiserConfig::paper(),
-        }
-    }
-
-    fn sata(self) -> SataConfig {
-        match self {
-            Preset::Tiny => SataConfig::tiny(),
-            Preset::Small => SataConfig::small(),
-            Preset::Paper => SataConfig::paper(),
-        }
-    }
-}
-
 /// Exit code after an interruption (128 + SIGINT, what shells report for Ctrl-C).
 pub const INTERRUPTED_EXIT: u8 = 130;
 
 /// Set by Ctrl-C / SIGTERM; the loop stops at the next step boundary.
 static STOP: StopFlag = StopFlag::new();
 
-/// Install the signal handler once per process: the first signal asks the loop to stop at
-/// the next step boundary; a second one quits at once unless a checkpoint is being written
-/// (then the save finishes and the loop stops).
+/// The first signal asks the loop to stop at the next step boundary; a second one quits at
+/// once unless a checkpoint is being written (`StopFlag::catch_interrupts`).
 fn catch_interrupts() -> anyhow::Result<()> {
-    static INSTALLED: OnceLock<Result<(), String>> = OnceLock::new();
-    let installed = INSTALLED.get_or_init(|| {
-        ctrlc::set_handler(|| {
-            if STOP.request() && !STOP.saving() {
-                eprintln!("\nmo-train: interrupted twice, quitting without saving (the last checkpoint is whole)");
-                crate::io::output::remove_temps_and_exit(INTERRUPTED_EXIT as i32);
-            }
-        })
-        .map_err(|e| e.to_string())
-    });
-    STOP.reset();
-    installed.clone().map_err(|e| anyhow::anyhow!("cannot catch Ctrl-C: {e}"))
+    let twice = || {
+        eprintln!("\nmo-train: interrupted twice, quitting without saving (the last checkpoint is whole)");
+        crate::io::output::remove_temps_and_exit(INTERRUPTED_EXIT as i32);
+    };
+    STOP.catch_interrupts(twice).map_err(|e| anyhow::anyhow!("cannot catch Ctrl-C: {e}"))
 }
 
 /// The learning rate of a fine-tune (`--init`) when none is given.
@@ -263,21 +229,14 @@ impl Resolved {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     args.common.init_threads()?;
     crate::nn::keep_freed_memory();
+    // --lr, --lambda-geo and --lambda-vel are checked by clap (`bounds::positive`, `non_negative`).
     let resolved = Resolved::of(args);
-    if !(resolved.lr.is_finite() && resolved.lr > 0.0) {
-        bail!("--lr must be a positive number, found {}", resolved.lr);
-    }
     if args.init.is_some() && args.arch != Arch::Anytop {
         bail!("--init fine-tunes the diffusion model (--arch anytop), not --arch sata");
     }
     // Before any work or message: --out must be (or become) a directory.
     if args.out.exists() && !args.out.is_dir() {
         bail!("--out {}: not a directory (the model directory to write)", args.out.display());
-    }
-    for (flag, w) in [("--lambda-geo", args.lambda_geo), ("--lambda-vel", args.lambda_vel)] {
-        if !(w.is_finite() && w >= 0.0) {
-            bail!("{flag} must be a weight >= 0, found {w}");
-        }
     }
     if let Some(shift) = args.noise_shift.filter(|&s| s < 1.0) {
         bail!("--noise-shift must be at least 1 (1 = AnyTop's schedule), found {shift}");
@@ -294,7 +253,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// `--arch anytop`: a new, resumed or fine-tuned diffusion model; returns the steps done.
 fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Result<u64> {
     let opts = AnyTopOptions {
-        config: args.preset.config(),
+        config: DenoiserConfig::preset(args.preset),
         seed: args.common.seed,
         lr: resolved.lr,
         batch: args.batch as usize,
@@ -322,8 +281,8 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
 /// `--arch sata`: a new or resumed latent autoencoder; returns the steps done.
 fn train_sata(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Result<u64> {
     let config = match args.crop {
-        Some(crop) => args.preset.sata().with_window(crop as usize),
-        None => args.preset.sata(),
+        Some(crop) => SataConfig::preset(args.preset).with_window(crop as usize),
+        None => SataConfig::preset(args.preset),
     };
     let opts = SataOptions {
         config,
@@ -404,22 +363,10 @@ fn train(args: &Args, resolved: &Resolved, first: u64, trainer: &mut impl Traine
 
 /// The clips of DATA grouped by skeleton, with augmented variants, as both architectures use.
 fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
-    let say = |msg: String| say(args, &msg);
-    let files = expand_inputs(&args.data)?;
-    let loaded = load_motions(&files, &LoadOptions::default())?;
-    let clips = loaded;
+    let clips = load_motions(&expand_inputs(&args.data)?, &LoadOptions::default())?;
     let names = NameTable::builtin().context("the built-in joint-name table")?;
     let augmentation = Augmentation { probability: resolved.augment, variants: args.augment_variants as usize, seed };
     let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;
-    for d in &dropped {
-        say(format!("{d}: too short to crop, left out"));
-    }
-    say(set.summary());
-    for v in &set.skipped_variants {
-        say(format!("augmented variant left out: {v}"));
-    }
-    if args.common.verbose {
-        set.variant_lines().into_iter().for_each(say);
-    }
+    set.report(&dropped, args.common.verbose).iter().for_each(|line| say(args, line));
     Ok(set)
 }

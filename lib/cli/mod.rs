@@ -8,7 +8,6 @@
 
 pub mod bounds;
 pub mod docs;
-pub mod latent;
 pub mod load;
 pub mod mo_dift;
 pub mod mo_edit;

@@ -5,8 +5,11 @@
 //! Each of these was once copied into every tool that needed it, and the copies drifted (one
 //! tool wrote all-or-nothing, the others file by file); here there is one of each.
 
-use crate::io::{self, npy};
+use crate::io;
+use crate::motion::write::{motion_file, MotionFormat};
+use crate::motion::Motion;
 use crate::repr::Features;
+use crate::skeleton::Skeleton;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
@@ -35,31 +38,30 @@ impl OutFormat {
     }
 }
 
-/// Refuse to write binary (`what`, e.g. "NPY") to a terminal: never wanted, and it can upset
-/// the terminal. `hint` says what to do instead.
-pub fn refuse_terminal(output: Option<&Path>, what: &str, hint: &str) -> anyhow::Result<()> {
-    Ok(io::refuse_terminal(output, what, hint)?)
-}
-
-/// One NPY of feature tensors of one shape: `[frames, joints, dims]` for a single tensor unless
-/// `always_batch`, else `[count, frames, joints, dims]`.
-pub fn features_npy(features: &[Features], always_batch: bool) -> anyhow::Result<Vec<u8>> {
-    let first = features.first().context("no features to write")?;
-    let mut shape = first.shape().to_vec();
-    if always_batch || features.len() > 1 {
-        shape.insert(0, features.len());
-    }
-    let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
-    let mut bytes = Vec::new();
-    npy::write_f32_parts(&mut bytes, &shape, &parts).context("building the NPY")?;
-    Ok(bytes)
-}
-
 /// Write every output or none: files atomically, stdout (`None` or `-`) last, since it cannot
 /// be taken back; when a file cannot be written, the files of this call already written are
 /// removed.
 pub fn write_all(outputs: &[(Option<PathBuf>, Vec<u8>)]) -> anyhow::Result<()> {
     Ok(io::write_all(&outputs.iter().map(|(p, b)| (p.as_deref(), b.as_slice())).collect::<Vec<_>>())?)
+}
+
+/// Motions on `skeleton` written to `paths` (all or none; `None` = stdout), each file in the
+/// format its extension asks for, else `stdout`'s (`motion::write::motion_file`).
+pub fn write_motions<'a>(
+    skeleton: &Skeleton,
+    motions: impl IntoIterator<Item = &'a Motion>,
+    paths: &[Option<PathBuf>],
+    stdout: MotionFormat,
+) -> anyhow::Result<()> {
+    let file = |(m, p): (&Motion, &Option<PathBuf>)| Ok((p.clone(), motion_file(skeleton, m, p.as_deref(), stdout)?));
+    write_all(&motions.into_iter().zip(paths).map(file).collect::<anyhow::Result<Vec<_>>>()?)
+}
+
+/// Feature tensors as one NPY (`Features::batch_npy`) on `output`, never on a terminal (`hint`
+/// says what to do instead).
+pub fn write_npy(output: Option<&Path>, features: &[Features], always_batch: bool, hint: &str) -> anyhow::Result<()> {
+    io::refuse_terminal(output, "NPY", hint)?;
+    Ok(io::write_output(output, &Features::batch_npy(features, always_batch).context("building the NPY")?)?)
 }
 
 /// `count` file names from a pattern with `{i}` (or one name for one file).

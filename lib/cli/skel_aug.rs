@@ -83,7 +83,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let options = options(args)?;
     let count = usize::try_from(args.variants).context("too many variants")?;
     // Output paths first: a bad pattern fails before any work and before any output.
-    let outputs = output_paths(args.common.output.as_deref(), count)?;
+    let hint = format!("('{{i}}' becomes 0..{})", count.saturating_sub(1));
+    let outputs = io::numbered_outputs(args.common.output.as_deref(), count, "variants", &hint).map_err(anyhow::Error::msg)?;
 
     let (name, bytes) = io::read_named(&args.input)?;
     let input = Source::parse(&bytes, &name, &args.input, &crate::cli::load::gltf_options())?;
@@ -126,28 +127,4 @@ fn options(args: &Args) -> anyhow::Result<augment::Options> {
         (false, Some(r)) => bail!("--remove-rate {r}: must be between 0 and 1, exclusive (use --no-remove to remove nothing)"),
     };
     Ok(augment::Options { remove, add: args.add, keep_feet: !args.allow_feet })
-}
-
-/// One output per variant: `None` = stdout.
-fn output_paths(output: Option<&Path>, count: usize) -> anyhow::Result<Vec<Option<PathBuf>>> {
-    match output {
-        Some(p) if p.as_os_str() != "-" => (0..count).map(|i| io::numbered_output(p, i, count).map(Some).map_err(anyhow::Error::msg)).collect(),
-        _ if count > 1 => bail!("{count} variants need a numbered output path such as -o 'out_{{i}}.bvh' ('{{i}}' becomes 0..{})", count - 1),
-        _ => Ok(vec![None]),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn output_patterns() {
-        assert_eq!(output_paths(None, 1).unwrap(), vec![None]);
-        assert!(output_paths(None, 2).is_err());
-        assert!(output_paths(Some(Path::new("-")), 2).is_err());
-        assert!(output_paths(Some(Path::new("a.bvh")), 2).is_err());
-        let p = output_paths(Some(Path::new("a_{i}.bvh")), 2).unwrap();
-        assert_eq!(p, vec![Some(PathBuf::from("a_0.bvh")), Some(PathBuf::from("a_1.bvh"))]);
-    }
 }

@@ -378,9 +378,15 @@ impl TrainSet {
         )
     }
 
-    /// One line per augmented variant: its name, joints and clips.
-    pub fn variant_lines(&self) -> Vec<String> {
-        self.augmented.iter().flatten().map(|v| format!("variant {}: {} joints, {} clips", v.name, v.skeleton.len(), v.clips.len())).collect()
+    /// What a trainer says about the set: the clips `build` dropped, the `summary`, the
+    /// variants left out and, when `verbose`, one line per augmented variant (name, joints, clips).
+    pub fn report(&self, dropped: &[String], verbose: bool) -> Vec<String> {
+        let mut lines: Vec<String> = dropped.iter().map(|d| format!("{d}: too short to crop, left out")).collect();
+        lines.push(self.summary());
+        lines.extend(self.skipped_variants.iter().map(|v| format!("augmented variant left out: {v}")));
+        let variant = |v: &SkeletonData| format!("variant {}: {} joints, {} clips", v.name, v.skeleton.len(), v.clips.len());
+        lines.extend(self.augmented.iter().flatten().filter(|_| verbose).map(variant));
+        lines
     }
 
     /// Draw `batch` crops of at most `frames` feature frames: a skeleton uniformly (each gets

@@ -5,7 +5,7 @@
 //! text the same way and refuse the same requests.
 
 use super::edit::{parse_frame_ranges, select_joints, EditError, KeepMask};
-use crate::motion::Clip;
+use crate::motion::{Clip, ClipError};
 use crate::repr::anytop::{AnyTopRig, Placement};
 use crate::repr::Features;
 use crate::skeleton::Skeleton;
@@ -66,6 +66,28 @@ impl Kept {
     }
 }
 
+/// Why a reference clip could not be read (a bad skeleton's message names the file already;
+/// other parse errors say it is the reference).
+#[derive(Debug, thiserror::Error)]
+pub enum ReferenceError {
+    #[error("cannot read the reference {name}")]
+    Read {
+        name: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("the reference {name}")]
+    Parse {
+        name: String,
+        #[source]
+        source: ClipError,
+    },
+    #[error(transparent)]
+    Skeleton(ClipError),
+    #[error(transparent)]
+    Edit(#[from] EditError),
+}
+
 /// The reference clip of an edit, encoded on the sampled skeleton's rig.
 pub struct Reference {
     pub name: String,
@@ -75,6 +97,30 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// Read the reference clip at `path` (`-` = stdin; glTF as `gltf` says) and `encode` it.
+    pub fn read(
+        path: &std::path::Path,
+        gltf: &crate::gltf::ReadOptions,
+        skeleton_name: &str,
+        skeleton: &Skeleton,
+        rig: &AnyTopRig,
+    ) -> Result<Reference, ReferenceError> {
+        let (name, bytes) = crate::io::read_named(path).map_err(|e| ReferenceError::Read { name: e.name, source: e.source })?;
+        let clip = Clip::from_bytes(&bytes, &name, path, gltf).map_err(|e| match e {
+            e @ ClipError::Skeleton { .. } => ReferenceError::Skeleton(e),
+            e => ReferenceError::Parse { name: name.clone(), source: e },
+        })?;
+        Ok(Reference::encode(clip, skeleton_name, skeleton, rig)?)
+    }
+
+    /// The cells `--keep-frames` and `--keep-joints` keep of this reference (`Kept`) in an
+    /// output of `frames` frames on `skeleton`: frames must exist in both the output and the
+    /// reference; joints are kept over every output frame the reference has.
+    pub fn mask(&self, keep_frames: Option<&str>, keep_joints: Option<&str>, skeleton: &Skeleton, frames: usize) -> Result<KeepMask, EditError> {
+        let why = format!("the output has {frames} frames, the reference {} has {} frames of features", self.name, self.features.frames);
+        Ok(Kept::resolve(keep_frames, keep_joints, skeleton, frames, self.features.frames, &why)?.mask())
+    }
+
     /// Encode `clip` with `rig`, the rig of `skeleton` (named `skeleton_name`), which the clip
     /// must be on; it needs two frames (AnyTop features drop the last).
     pub fn encode(clip: Clip, skeleton_name: &str, skeleton: &Skeleton, rig: &AnyTopRig) -> Result<Reference, EditError> {

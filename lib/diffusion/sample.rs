@@ -129,6 +129,16 @@ pub(super) fn denoise(
     Ok(x)
 }
 
+/// The default `--smooth`: 7 Hz, the lowest whole cutoff at which the post-process keeps real
+/// motion: on the bundled creatures and real clips (dog, chicken, flamingo, monkey, crab, a
+/// LAFAN1 walk) it changes motion energy by at most 7% (the wing beats of the bird; 4 Hz took
+/// 28% off them and 9% off the dog), `tests/it/post_process.rs`. What it leaves of the model's
+/// jitter is the model's to fix (models/zoo-small/MODEL_CARD.md).
+pub const DEFAULT_SMOOTH_HZ: f64 = 7.0;
+
+/// The default `--blend`: half a second (15 frames at 30 fps), the order of a step.
+pub const DEFAULT_BLEND_SECONDS: f64 = 0.5;
+
 /// What is done to sampled features before they are decoded: the model's frame-to-frame jitter
 /// smoothed away, and the root's travel taken from the planted feet so that they do not slide.
 /// `Default` is the raw output.

@@ -142,7 +142,7 @@ impl Schedule {
 }
 
 /// How a sampler goes from x_t to the next, less noisy step.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Sampler {
     /// Ancestral DDPM (the reference's, on all steps; respaced on fewer).

@@ -109,6 +109,24 @@ impl StopFlag {
         self.saving.load(Ordering::SeqCst)
     }
 
+    /// Make Ctrl-C and SIGTERM ask this flag to stop the loop at the next step boundary, and
+    /// reset it. The handler is installed once per process (for the first flag; later calls
+    /// only reset theirs and return the first installation's result); a second signal calls
+    /// `twice` unless a checkpoint is being written (then the save finishes and the loop stops).
+    pub fn catch_interrupts(&'static self, twice: fn()) -> Result<(), String> {
+        static INSTALLED: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+        let installed = INSTALLED.get_or_init(|| {
+            let handler = move || {
+                if self.request() && !self.saving() {
+                    twice();
+                }
+            };
+            ctrlc::set_handler(handler).map_err(|e| e.to_string())
+        });
+        self.reset();
+        installed.clone()
+    }
+
     fn guard<T>(&self, save: impl FnOnce() -> T) -> T {
         self.saving.store(true, Ordering::SeqCst);
         let result = save();

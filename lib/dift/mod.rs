@@ -60,6 +60,13 @@ pub enum DiftError {
     Tensor(#[from] candle_core::Error),
     #[error(transparent)]
     Names(#[from] crate::embed::EmbedError),
+    /// Extraction failed on the named clip.
+    #[error("{name}")]
+    Clip {
+        name: String,
+        #[source]
+        source: Box<DiftError>,
+    },
 }
 
 impl DiftError {
@@ -219,6 +226,18 @@ pub fn prepare_encoded(
         .map_err(|source| DiftError::Condition { file: file.to_string(), source })?;
     condition.stats.normalise(&mut features).map_err(DiftError::repr(file))?;
     Ok(PreparedMotion { condition, features })
+}
+
+/// DIFT features of a clip with `model` (`prepare`, then `extract`), what `mo-dift` writes.
+pub fn of_clip(
+    model: &crate::diffusion::checkpoint::FrozenDenoiser,
+    clip: &crate::motion::Clip,
+    opts: &DiftOptions,
+    device: &Device,
+) -> Result<DiftFeatures, DiftError> {
+    let prepared = prepare(&model.info, &clip.skeleton, &clip.motion, &clip.name)?;
+    let (schedule, condition) = (model.info.schedule(), prepared.condition.condition());
+    extract(&model.model, &schedule, &condition, &prepared.features, opts, device).map_err(|e| DiftError::Clip { name: clip.name.clone(), source: Box::new(e) })
 }
 
 /// Draws place the clip at a temporal position below this (training crops start anywhere in

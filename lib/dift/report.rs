@@ -14,10 +14,13 @@ use serde_json::{json, Value};
 /// The paper's binding rate, what `--features dift-only --as-binding` binds by default.
 pub const DIFT_BIND_RATE: f64 = 0.061;
 
-/// How frame matches are chosen: in time order (one monotonic path) or each frame's best.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How frame matches are chosen: in time order (one monotonic path) or each frame's best
+/// (`mo-dift --align`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Align {
+    /// In time order (dynamic time warping): the answers never go back.
     Monotonic,
+    /// Each target frame on its own: the most similar reference frame (the paper's rule).
     Nearest,
 }
 

@@ -10,6 +10,13 @@ use super::EditError;
 use crate::skeleton::{lookup, names, Skeleton};
 use std::collections::{BTreeMap, BTreeSet};
 
+/// Pairs old -> new from the map file at `path` (`-` = stdin): `parse_map`, errors naming it.
+pub fn read_map(path: &std::path::Path) -> Result<Vec<(String, String)>, EditError> {
+    let name = crate::io::display_name(path);
+    let text = crate::io::read_input(path).map_err(|e| EditError::Invalid(format!("cannot read {name}: {e}")))?;
+    parse_map(&String::from_utf8_lossy(&text)).map_err(|e| EditError::Invalid(format!("{name}: {e}")))
+}
+
 /// Pairs old -> new from a map file: a JSON object `{"old": "new"}`, or lines `old new`
 /// (a tab separates names that hold spaces; blank lines and `#` comments are skipped).
 pub fn parse_map(text: &str) -> Result<Vec<(String, String)>, EditError> {

@@ -65,10 +65,32 @@ pub fn numbered_output(pattern: &Path, i: usize, count: usize) -> Result<PathBuf
     }
 }
 
+/// The outputs of a batch of `count` items: files numbered from `output`'s `{i}` pattern, or
+/// stdout (`None`, for `None` and `-`) when there is one item. Several items on stdout are
+/// refused; the message says "`count` `what` need ..." and ends with `hint`.
+pub fn numbered_outputs(output: Option<&Path>, count: usize, what: &str, hint: &str) -> Result<Vec<Option<PathBuf>>, String> {
+    match output {
+        Some(p) if p.as_os_str() != "-" => (0..count).map(|i| numbered_output(p, i, count).map(Some)).collect(),
+        _ if count > 1 => Err(format!("{count} {what} need a numbered output path such as -o 'out_{{i}}.bvh' {hint}")),
+        _ => Ok(vec![None]),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::numbered_output;
-    use std::path::Path;
+    use std::path::{Path, PathBuf};
+
+    #[test]
+    fn output_patterns() {
+        let batch = |o: Option<&str>, n| super::numbered_outputs(o.map(Path::new), n, "variants", "(hint)");
+        assert_eq!(batch(None, 1).unwrap(), vec![None]);
+        assert_eq!(batch(Some("-"), 1).unwrap(), vec![None]);
+        assert_eq!(batch(None, 2).unwrap_err(), "2 variants need a numbered output path such as -o 'out_{i}.bvh' (hint)");
+        assert!(batch(Some("-"), 2).is_err());
+        assert!(batch(Some("a.bvh"), 2).is_err());
+        assert_eq!(batch(Some("a_{i}.bvh"), 2).unwrap(), vec![Some(PathBuf::from("a_0.bvh")), Some(PathBuf::from("a_1.bvh"))]);
+    }
 
     #[test]
     fn numbered_outputs() {

@@ -35,6 +35,10 @@ pub enum OutputError {
     LinkLoop { path: String },
     #[error("refusing to write {what} to a terminal: {hint}")]
     Terminal { what: String, hint: String },
+    #[error("{first} and {second} both write to stdout: give one of them a file")]
+    BothStdout { first: String, second: String },
+    #[error("{first} and {second} both write to {path}")]
+    BothFile { first: String, second: String, path: String },
 }
 
 /// Symlinks followed before giving up (Linux's own limit).
@@ -50,6 +54,21 @@ fn is_stdout(path: Option<&Path>) -> bool {
 pub fn refuse_terminal(path: Option<&Path>, what: &str, hint: &str) -> Result<(), OutputError> {
     if is_stdout(path) && io::stdout().is_terminal() {
         return Err(OutputError::Terminal { what: what.to_string(), hint: hint.to_string() });
+    }
+    Ok(())
+}
+
+/// Refuse two outputs of one run on one path (`-` is stdout); `outputs` are (what, path) in
+/// order, and the message names the first pair that clashes.
+pub fn distinct(outputs: &[(&str, &Path)]) -> Result<(), OutputError> {
+    for (i, (second, path)) in outputs.iter().enumerate() {
+        if let Some((first, _)) = outputs[..i].iter().find(|(_, p)| p == path) {
+            let (first, second) = (first.to_string(), second.to_string());
+            return Err(match is_stdout(Some(path)) {
+                true => OutputError::BothStdout { first, second },
+                false => OutputError::BothFile { first, second, path: path.display().to_string() },
+            });
+        }
     }
     Ok(())
 }
@@ -270,6 +289,16 @@ mod tests {
         write_all(&[(Some(&a), b"a"), (Some(&dir.join("c.txt")), b"c")]).unwrap();
         assert_eq!(fs::read(&a).unwrap(), b"a");
         fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn outputs_on_one_path_are_refused() {
+        let (a, b, dash) = (Path::new("a.npy"), Path::new("b.json"), Path::new("-"));
+        assert!(distinct(&[("-o", a), ("--stats", b)]).is_ok());
+        let err = distinct(&[("-o", a), ("--stats", b), ("--placement", a)]).unwrap_err();
+        assert_eq!(err.to_string(), "-o and --placement both write to a.npy");
+        let err = distinct(&[("-o", dash), ("--stats", b), ("--emit-skeleton", dash)]).unwrap_err();
+        assert_eq!(err.to_string(), "-o and --emit-skeleton both write to stdout: give one of them a file");
     }
 
     #[cfg(unix)]

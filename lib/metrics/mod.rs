@@ -88,4 +88,7 @@ pub enum MetricError {
     /// A NaN or infinity in the input, with where it is.
     #[error("{0}")]
     NonFinite(String),
+    /// An option out of its range, named as the tools name it.
+    #[error("{0}")]
+    BadOption(String),
 }

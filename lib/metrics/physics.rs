@@ -24,6 +24,22 @@ pub enum Ground {
     Estimate,
 }
 
+impl std::str::FromStr for Ground {
+    type Err = String;
+
+    /// `zero`, `estimate` or a finite height (the tools' `--ground`).
+    fn from_str(s: &str) -> Result<Ground, String> {
+        match s {
+            "zero" => Ok(Ground::Zero),
+            "estimate" => Ok(Ground::Estimate),
+            h => match h.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(Ground::Height(v)),
+                _ => Err(format!("expected zero, estimate or a height, found '{s}'")),
+            },
+        }
+    }
+}
+
 /// Thresholds of contact, as fractions of `WorldClip::scale`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct PhysicsOptions {
@@ -32,6 +48,16 @@ pub struct PhysicsOptions {
     /// ... and moving slower than this (fraction of the scale per second) is in contact.
     pub contact_speed: f64,
     pub ground: Ground,
+}
+
+impl PhysicsOptions {
+    /// Options with both thresholds checked positive (named as the tools' flags name them).
+    pub fn new(ground: Ground, contact_height: f64, contact_speed: f64) -> Result<PhysicsOptions, MetricError> {
+        if !(contact_height.is_finite() && contact_height > 0.0) || !(contact_speed.is_finite() && contact_speed > 0.0) {
+            return Err(MetricError::BadOption("--contact-height and --contact-speed must be positive numbers".to_string()));
+        }
+        Ok(PhysicsOptions { contact_height, contact_speed, ground })
+    }
 }
 
 impl Default for PhysicsOptions {
@@ -380,6 +406,17 @@ pub(crate) mod tests {
             positions.push(foot(f));
         }
         WorldClip { frames, joints: 2, fps, positions, parents: vec![None, Some(0)], names: vec!["Hips".into(), "LeftFoot".into()], feet: vec![1], scale: 1.0 }
+    }
+
+    #[test]
+    fn options_parse_and_check() {
+        assert_eq!("zero".parse(), Ok(Ground::Zero));
+        assert_eq!("estimate".parse(), Ok(Ground::Estimate));
+        assert_eq!("-0.5".parse(), Ok(Ground::Height(-0.5)));
+        assert!("inf".parse::<Ground>().unwrap_err().contains("expected zero, estimate or a height"));
+        assert_eq!(PhysicsOptions::new(Ground::Zero, 0.05, 0.5), Ok(PhysicsOptions::default()));
+        assert!(PhysicsOptions::new(Ground::Zero, -1.0, 0.5).unwrap_err().to_string().contains("must be positive numbers"));
+        assert!(PhysicsOptions::new(Ground::Zero, 0.05, f64::NAN).is_err());
     }
 
     #[test]

@@ -43,6 +43,8 @@ pub enum ReportError {
     /// Clips that cannot be compared, or a report that is not one, said in one sentence.
     #[error("{0}")]
     Invalid(String),
+    #[error(transparent)]
+    Read(#[from] crate::io::ReadError),
 }
 
 fn invalid(message: String) -> ReportError {
@@ -307,6 +309,16 @@ fn movement_report(gt: &[Clip], gen: &[Clip], gt_points: &[PointClip], gen_point
 /// The metrics a generation report carries, in table order.
 const GENERATION_METRICS: [&str; 7] =
     ["coverage", "local_diversity", "global_diversity", "inter_diversity", "intra_diversity", "gt_intra_diversity", "intra_diversity_diff"];
+
+/// The JSON reports in `paths` (`-` = stdin), each with its file's name, for `aggregate_report`.
+pub fn read_reports(paths: &[std::path::PathBuf]) -> Result<Vec<(String, Value)>, ReportError> {
+    let read = |path: &std::path::PathBuf| {
+        let (name, bytes) = crate::io::read_named(path)?;
+        let value = serde_json::from_slice(&bytes).map_err(|e| invalid(format!("{name}: not JSON: {e}")))?;
+        Ok((name, value))
+    };
+    paths.iter().map(read).collect()
+}
 
 /// `mo-metrics aggregate`: mean and std over skeletons of the per-skeleton means of generation
 /// reports (each with the name of the file it came from).

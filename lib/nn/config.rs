@@ -34,7 +34,24 @@ pub struct DenoiserConfig {
     pub ln_eps: f64,
 }
 
+/// The model sizes the trainers offer (`mo-train --preset`), for the denoiser and SATA alike.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preset {
+    Tiny,
+    Small,
+    Paper,
+}
+
 impl DenoiserConfig {
+    /// The denoiser of a preset size.
+    pub fn preset(preset: Preset) -> DenoiserConfig {
+        match preset {
+            Preset::Tiny => DenoiserConfig::tiny(),
+            Preset::Small => DenoiserConfig::small(),
+            Preset::Paper => DenoiserConfig::paper(),
+        }
+    }
+
     /// The reference model (docs/reference/anytop.md §2.1): width 128, 4 layers, 4 heads, ff 1024,
     /// W 31, d_max 5; names are 384-d MiniLM embeddings instead of 768-d T5.
     pub fn paper() -> DenoiserConfig {

@@ -23,7 +23,7 @@ mod tests;
 
 pub use anytop::Denoiser;
 pub use batch::{batch_from, Batch, BatchItem};
-pub use config::DenoiserConfig;
+pub use config::{DenoiserConfig, Preset};
 pub use init::seeded_var_builder;
 
 /// Tells glibc's allocator to keep freed memory instead of returning it to the OS.

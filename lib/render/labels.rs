@@ -43,7 +43,20 @@ fn label_text(v: &Value, file: &str, at: &str) -> Result<Option<String>, RenderE
     }
 }
 
+/// A label file's name for messages and its text (`-` = stdin).
+fn read_text(path: &std::path::Path) -> Result<(String, String), RenderError> {
+    let (name, bytes) = crate::io::read_named(path).map_err(|e| RenderError::Read(format!("{e}: {}", e.source)))?;
+    let text = String::from_utf8(bytes).map_err(|_| RenderError::Read(format!("{name}: not UTF-8 text")))?;
+    Ok((name, text))
+}
+
 impl JointLabels {
+    /// Read a joint label file: the labels and the file's name.
+    pub fn read(path: &std::path::Path) -> Result<(JointLabels, String), RenderError> {
+        let (name, text) = read_text(path)?;
+        Ok((JointLabels::from_json(&text, &name)?, name))
+    }
+
     /// Parse a joint label file (`file` names it in errors).
     pub fn from_json(text: &str, file: &str) -> Result<JointLabels, RenderError> {
         let value: Value = serde_json::from_str(text).map_err(|e| RenderError::Invalid(format!("{file}: not JSON: {e}")))?;
@@ -75,6 +88,12 @@ impl FrameLabels {
             }
         }
         Ok(())
+    }
+
+    /// Read a frame label file: the labels and the file's name.
+    pub fn read(path: &std::path::Path) -> Result<(FrameLabels, String), RenderError> {
+        let (name, text) = read_text(path)?;
+        Ok((FrameLabels::from_json(&text, &name)?, name))
     }
 
     /// Parse a frame label file (`file` names it in errors).

@@ -13,6 +13,7 @@ pub mod font;
 pub mod gif;
 pub mod html;
 pub mod labels;
+pub mod picture;
 pub mod raster;
 pub mod sheet;
 
@@ -199,6 +200,9 @@ pub enum RenderError {
     /// Options that contradict each other or the input (a label index outside the legend...).
     #[error("{0}")]
     Invalid(String),
+    /// A file that could not be read (names it and why).
+    #[error("{0}")]
+    Read(String),
 }
 
 /// Check tracks before drawing: something to draw, consistent lengths, finite positions and

@@ -12,8 +12,8 @@ use crate::motion::Motion;
 use crate::skeleton::Skeleton;
 use std::borrow::Cow;
 
-/// Where AnyTop decoding takes the rotations from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Where AnyTop decoding takes the rotations from (also the tools' `--from`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum PoseFrom {
     /// The features' 6D rotations: exact for encoded features.
     Rotations,

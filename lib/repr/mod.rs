@@ -19,6 +19,20 @@ pub struct Features {
 }
 
 impl Features {
+    /// Tensors of one shape as one NPY: `[frames, joints, dims]` for a single tensor unless
+    /// `always_batch`, else `[count, frames, joints, dims]`.
+    pub fn batch_npy(features: &[Features], always_batch: bool) -> std::io::Result<Vec<u8>> {
+        let first = features.first().ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "no features to write"))?;
+        let mut shape = first.shape().to_vec();
+        if always_batch || features.len() > 1 {
+            shape.insert(0, features.len());
+        }
+        let parts: Vec<&[f32]> = features.iter().map(|f| f.data.as_slice()).collect();
+        let mut bytes = Vec::new();
+        crate::io::npy::write_f32_parts(&mut bytes, &shape, &parts)?;
+        Ok(bytes)
+    }
+
     pub fn zeros(frames: usize, joints: usize, dims: usize) -> Features {
         Features { frames, joints, dims, data: vec![0.0; frames * joints * dims] }
     }

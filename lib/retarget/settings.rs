@@ -12,7 +12,7 @@ use super::RetargetError;
 /// pair (spider -> crab, frequency alignment 0.83 vs 0.05) but loses clearly on three
 /// (Flamingo -> Monkey auto 0.79 vs 0.93, Monkey -> Flamingo 0.89 vs 0.92, quadruped -> dragon
 /// 0.90 vs 0.93): no variant is better by the numbers across pairs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum BoundRotation {
     /// The source's local rotation, copied as is (the reference's behaviour).
     #[default]
@@ -31,7 +31,7 @@ pub enum BoundRotation {
 /// The default stays `Examples`: `Source` changed frequency alignment by -0.026..+0.010 and
 /// contact consistency by -0.006..+0.008 on the same pairs (mostly down): no gain; it is
 /// for sources that travel while the examples walk in place.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum RootMotion {
     /// Synthesised from the examples like any unbound channel (the reference's behaviour).
     #[default]
@@ -43,7 +43,7 @@ pub enum RootMotion {
 
 /// The per-frame features patches are matched on (paper table 4). Blending always carries the
 /// rotation features too, which is what the output is decoded from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Repr {
     /// Local 6D rotations of every joint plus the root's dx, y, dz (the paper's default).
     #[default]

@@ -28,6 +28,10 @@ pub enum LatentError {
     Input(#[from] InputError),
     #[error(transparent)]
     Npy(#[from] NpyError),
+    #[error(transparent)]
+    Read(#[from] crate::io::ReadError),
+    #[error(transparent)]
+    Clip(#[from] crate::motion::ClipError),
     #[error("{name}: cannot build an AnyTop rig")]
     Rig {
         name: String,
@@ -90,6 +94,16 @@ pub struct SourceClip {
 }
 
 impl SourceClip {
+    /// A motion file read for encoding, glTF as `gltf` says (an NPY is refused: it holds
+    /// features, not a clip).
+    pub fn read(path: &Path, gltf: &crate::gltf::ReadOptions, model: &FrozenAutoencoder, device: &Device) -> Result<SourceClip, LatentError> {
+        let (name, bytes) = crate::io::read_named(path)?;
+        if bytes.starts_with(b"\x93NUMPY") {
+            return Err(LatentError::Invalid(format!("{name}: expected a BVH clip to encode, found an NPY file (decode features first: mo-encode --decode)")));
+        }
+        SourceClip::new(Clip::from_bytes(&bytes, &name, path, gltf)?, model, device)
+    }
+
     pub fn new(clip: Clip, model: &FrozenAutoencoder, device: &Device) -> Result<SourceClip, LatentError> {
         let Clip { name, skeleton, motion } = clip;
         if motion.frames < 2 {
@@ -150,6 +164,12 @@ pub fn latents_of(array: NpyArray, name: &str) -> Result<Latents, LatentError> {
         return Err(LatentError::Invalid(format!("{name}: non-finite latent at frame {}, dim {}", k / shape[1], k % shape[1])));
     }
     Ok(Latents { frames: shape[0], dims: shape[1], data })
+}
+
+/// Latents `[frames, latent]` from an NPY file (`-` = stdin).
+pub fn read_latents(path: &Path) -> Result<Latents, LatentError> {
+    let (name, bytes) = crate::io::read_named(path)?;
+    latents_of(npy::from_bytes(&bytes, &name)?, &name)
 }
 
 /// Latents as NPY bytes, `[frames, latent]` float32.

@@ -104,6 +104,15 @@ impl SataConfig {
         self
     }
 
+    /// The autoencoder of a preset size.
+    pub fn preset(preset: crate::nn::Preset) -> SataConfig {
+        match preset {
+            crate::nn::Preset::Tiny => SataConfig::tiny(),
+            crate::nn::Preset::Small => SataConfig::small(),
+            crate::nn::Preset::Paper => SataConfig::paper(),
+        }
+    }
+
     /// The paper's base model (§4.1.1): width 256, 3 + 3 blocks, 4 heads, ff 512, latent 128,
     /// windows of 64 frames overlapping by 16.
     pub fn paper() -> SataConfig {

@@ -45,6 +45,12 @@ pub enum SegmentInputError {
     /// The skeleton file given with the motion.
     #[error(transparent)]
     Skeleton(#[from] InputError),
+    #[error(transparent)]
+    Read(#[from] crate::io::ReadError),
+    #[error(transparent)]
+    Clip(#[from] crate::motion::ClipError),
+    #[error(transparent)]
+    Npy(#[from] crate::io::npy::NpyError),
 }
 
 /// A motion to segment, as its AnyTop features: what every feature provider gets.
@@ -94,6 +100,20 @@ impl Input {
 }
 
 impl Input {
+    /// The input of `mo-segment` at `path` (`-` = stdin): a motion file (`from_clip`) or an NPY
+    /// of AnyTop features (`from_npy`), with the skeleton file at `skeleton` if one is given.
+    pub fn read(path: &std::path::Path, skeleton: Option<&std::path::Path>, gltf: &crate::gltf::ReadOptions) -> Result<Input, SegmentInputError> {
+        let (name, bytes) = crate::io::read_named(path)?;
+        let skeleton = skeleton.map(|p| SkeletonFile::read(p, gltf)).transpose()?;
+        if !crate::io::npy::looks_like_npy(path, &bytes) {
+            let clip = Clip::from_bytes(&bytes, &name, path, gltf)?;
+            drop(bytes);
+            return Input::from_clip(clip, skeleton);
+        }
+        let array = crate::io::npy::from_bytes(&bytes, &name)?;
+        Input::from_npy(name, array, skeleton)
+    }
+
     /// A motion file's clip, encoded with the rig of `skeleton` when one is given (so that the
     /// features are those `mo-encode --skeleton` makes with it), else with its own.
     pub fn from_clip(clip: Clip, skeleton: Option<SkeletonFile>) -> Result<Input, SegmentInputError> {

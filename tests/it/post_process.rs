@@ -5,8 +5,8 @@
 use crate::common;
 
 use menagerie::bvh;
-use menagerie::cli::mo_sample::DEFAULT_SMOOTH_HZ;
 use menagerie::diffusion::sample::PostProcess;
+use menagerie::diffusion::sample::DEFAULT_SMOOTH_HZ;
 use menagerie::metrics::movement::energy;
 use menagerie::metrics::WorldClip;
 use menagerie::motion::Motion;

@@ -28,6 +28,13 @@ enum PlacementFile {
     One(Placement),
 }
 
+/// One placement per sample from the placement file at `path` (`-` = stdin): `from_json`.
+pub fn read(path: &std::path::Path, samples: usize, npy_name: &str) -> Result<Vec<Placement>, String> {
+    let name = crate::io::display_name(path);
+    let bytes = crate::io::read_input(path).map_err(|e| format!("cannot read placements {name}: {e}"))?;
+    from_json(&bytes, &name, samples, npy_name)
+}
+
 /// One placement per sample from the bytes of a placement file (`name`, for messages), which
 /// must hold `samples` of them (the samples of `npy_name`).
 pub fn from_json(bytes: &[u8], name: &str, samples: usize, npy_name: &str) -> Result<Vec<Placement>, String> {
