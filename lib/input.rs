@@ -13,7 +13,7 @@ use crate::io::npy::{self, NpyArray, NpyError};
 use crate::io::{self};
 use crate::motion::clip::{self, Clip, ClipError};
 use crate::motion::Motion;
-use crate::repr::anytop::{self, AnyTopError, AnyTopStats, NamedOverrides, RestSource, RigOptions};
+use crate::repr::anytop::{self, AnyTopError, AnyTopStats, NamedOverrides, RestSource, RigError, RigOptions};
 use crate::repr::batch::{split_samples, FeatureDecoder, PoseFrom};
 use crate::repr::m2m;
 use crate::skeleton::{topology, Skeleton, SkeletonError};
@@ -53,12 +53,8 @@ pub enum InputError {
         #[source]
         source: AnyTopError,
     },
-    #[error("{name}: cannot build an AnyTop rig")]
-    Rig {
-        name: String,
-        #[source]
-        source: AnyTopError,
-    },
+    #[error(transparent)]
+    Rig(#[from] RigError),
     /// Input that is not what it should be, said in one sentence.
     #[error("{0}")]
     Invalid(String),
@@ -136,7 +132,7 @@ impl SkeletonFile {
         }
         let (rest, rest_source) = self.own_rest();
         let options = RigOptions { rest_source, ..RigOptions::default() };
-        AnyTopSection::new(&self.skeleton, &rest, &options).map_err(|source| InputError::Rig { name: self.name.clone(), source })
+        AnyTopSection::new(&self.skeleton, &rest, &options).map_err(|source| InputError::from(RigError { name: self.name.clone(), source }))
     }
 }
 
@@ -166,7 +162,7 @@ impl SkeletonFile {
             None => self.own_rest(),
         };
         let options = overrides.resolve(&self.skeleton, &self.name, source).map_err(invalid)?;
-        let rig_error = |source| InputError::Rig { name: self.name.clone(), source };
+        let rig_error = |source| InputError::from(RigError { name: self.name.clone(), source });
         let mut section = AnyTopSection::new(&self.skeleton, &rest, &options).map_err(rig_error)?;
         if let Some(motion) = self.motion.as_ref().filter(|m| want_stats && m.frames >= 2) {
             let stats_error = |source| InputError::Stats { name: self.name.clone(), source };

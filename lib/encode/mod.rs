@@ -17,7 +17,7 @@ use crate::input::{self, InputError, SkeletonFile};
 use crate::io;
 use crate::motion::clip::{self, Clip, RestChoice};
 use crate::motion::Motion;
-use crate::repr::anytop::{AnyTopError, AnyTopStats, NamedOverrides, Placement, RestSource};
+use crate::repr::anytop::{AnyTopError, AnyTopStats, NamedOverrides, Placement, RestSource, RigError};
 use crate::repr::{batch, m2m, Features};
 use crate::skeleton::{topology, Skeleton};
 use rayon::prelude::*;
@@ -36,12 +36,8 @@ pub enum EncodeError {
     Read(#[from] io::ReadError),
     #[error(transparent)]
     Clip(#[from] clip::ClipError),
-    #[error("{name}: cannot build an AnyTop rig")]
-    Rig {
-        name: String,
-        #[source]
-        source: AnyTopError,
-    },
+    #[error(transparent)]
+    Rig(#[from] RigError),
     #[error("{name}: cannot encode with the AnyTop rig of {rig}")]
     Encode {
         name: String,
@@ -147,7 +143,7 @@ impl Rig {
         };
         let options = overrides.resolve(&rest.skeleton, &rest.name, source).map_err(EncodeError::Invalid)?;
         let section = AnyTopSection::new(&rest.skeleton, &rest.motion.first_frames(2), &options)
-            .map_err(|source| EncodeError::Rig { name: rest.name.clone(), source })?;
+            .map_err(|source| EncodeError::from(RigError { name: rest.name.clone(), source }))?;
         // The document describes the encoded clips (their frame time), with the rig.
         let document = SkeletonDocument::build(&first.skeleton, first_info, &first.name, topology::DEFAULT_DMAX);
         Ok(Rig { document, section, source: rest.name.clone() })

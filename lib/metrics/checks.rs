@@ -5,7 +5,7 @@
 use super::report::ReportError;
 use crate::document::AnyTopSection;
 use crate::motion::Clip;
-use crate::repr::anytop::RigOptions;
+use crate::repr::anytop::{RigError, RigOptions};
 
 /// A reference and a result for reconstruction metrics: one skeleton, one length. A result one
 /// frame short of the reference (an encode -> decode round trip: features of an F-frame clip
@@ -78,7 +78,7 @@ pub fn one_skeleton(gt: &[Clip], generated: &[Clip]) -> Result<(), ReportError> 
 /// the first ground-truth clip as AnyTop would, so positions share AnyTop's scale.
 pub fn generation_rig(first: &Clip) -> Result<AnyTopSection, ReportError> {
     AnyTopSection::new(&first.skeleton, &first.motion.first_frames(2), &RigOptions::default())
-        .map_err(|source| ReportError::Rig { name: first.name.clone(), source })
+        .map_err(|source| ReportError::from(RigError { name: first.name.clone(), source }))
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use super::physics::{self, PhysicsOptions};
 use super::{geometric, kinetic, movement, reconstruction, transfer, MetricError, WorldClip};
 use crate::document::AnyTopSection;
 use crate::motion::Clip;
-use crate::repr::anytop::AnyTopError;
+use crate::repr::anytop::{AnyTopError, RigError};
 use serde_json::{json, Map, Value};
 
 /// Why a report could not be made; messages name the clip.
@@ -32,12 +32,8 @@ pub enum ReportError {
         #[source]
         source: AnyTopError,
     },
-    #[error("{name}: cannot build an AnyTop rig")]
-    Rig {
-        name: String,
-        #[source]
-        source: AnyTopError,
-    },
+    #[error(transparent)]
+    Rig(#[from] RigError),
     #[error(transparent)]
     Json(#[from] serde_json::Error),
     /// Clips that cannot be compared, or a report that is not one, said in one sentence.

@@ -14,7 +14,7 @@ use crate::embed::NameTable;
 use crate::input::{InputError, SkeletonFile};
 use crate::io::npy::{self, NpyArray, NpyError};
 use crate::motion::{Clip, Motion};
-use crate::repr::anytop::AnyTopError;
+use crate::repr::anytop::{AnyTopError, RigError};
 use crate::skeleton::Skeleton;
 use candle_core::Device;
 use std::path::Path;
@@ -32,12 +32,8 @@ pub enum LatentError {
     Read(#[from] crate::io::ReadError),
     #[error(transparent)]
     Clip(#[from] crate::motion::ClipError),
-    #[error("{name}: cannot build an AnyTop rig")]
-    Rig {
-        name: String,
-        #[source]
-        source: AnyTopError,
-    },
+    #[error(transparent)]
+    Rig(#[from] RigError),
     #[error("{name}: cannot encode")]
     Encode {
         name: String,
@@ -112,7 +108,7 @@ impl SourceClip {
                 motion.frames
             )));
         }
-        let own = || AnyTopSection::of_clip(&skeleton, &motion, &name).map_err(|source| LatentError::Rig { name: name.clone(), source });
+        let own = || AnyTopSection::of_clip(&skeleton, &motion, &name).map_err(|source| LatentError::from(RigError { name: name.clone(), source }));
         let (section, skeleton) = rig_for(model, &skeleton, own)?;
         let prepared = PreparedSkeleton::new(&skeleton, section, names()?, device).map_err(|source| LatentError::Model { what: name.clone(), source })?;
         Ok(SourceClip { name, skeleton, motion, prepared })

@@ -10,7 +10,7 @@ use crate::dift::{self, DiftError, DiftOptions};
 use crate::document::AnyTopSection;
 use crate::input::{InputError, SkeletonFile};
 use crate::motion::{Clip, Motion};
-use crate::repr::anytop::{AnyTopError, FEATURE_DIMS};
+use crate::repr::anytop::{RigError, FEATURE_DIMS};
 use crate::repr::batch::split_samples;
 use crate::repr::Features as ReprFeatures;
 use crate::skeleton::Skeleton;
@@ -18,12 +18,8 @@ use crate::skeleton::Skeleton;
 /// Why a motion could not be prepared or segmented; every message names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum SegmentInputError {
-    #[error("{name}: cannot build an AnyTop rig")]
-    Rig {
-        name: String,
-        #[source]
-        source: AnyTopError,
-    },
+    #[error(transparent)]
+    Rig(#[from] RigError),
     // Boxed: a DIFT error is large, and every result here carries this type.
     #[error(transparent)]
     Dift(Box<DiftError>),
@@ -81,7 +77,7 @@ impl Input {
                 motion.frames
             )));
         }
-        let section = AnyTopSection::of_clip(&skeleton, &motion, &name).map_err(|source| SegmentInputError::Rig { name: name.clone(), source })?;
+        let section = AnyTopSection::of_clip(&skeleton, &motion, &name).map_err(|source| SegmentInputError::from(RigError { name: name.clone(), source }))?;
         Input::with_record(name, skeleton, motion, section)
     }
 

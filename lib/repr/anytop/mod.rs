@@ -269,6 +269,16 @@ pub struct Encoded {
     pub placement: Placement,
 }
 
+/// A named clip's skeleton that no AnyTop rig could be built for: the one message every
+/// reader of clips gives (input, encode, segment, latent and metrics errors wrap it).
+#[derive(Debug, thiserror::Error)]
+#[error("{name}: cannot build an AnyTop rig")]
+pub struct RigError {
+    pub name: String,
+    #[source]
+    pub source: AnyTopError,
+}
+
 /// Errors of this module: inputs that do not fit together.
 #[derive(Debug, thiserror::Error)]
 pub enum AnyTopError {
