@@ -82,9 +82,14 @@ def cells(m, ranges=False):
             lo, hi = m[k + "_range"]
             return f"{m[k]:.3f} ({lo:.3f}-{hi:.3f})"
         return f"{m[k]:.3f}"
-    def num(v):
-        return "-" if v is None else f"{v:.3f}"
-    return [num(m.get(k)) for k, _ in METRICS] + [phys(k) for k, _ in PHYSICS]
+    return [num(m.get(k), k) for k, _ in METRICS] + [phys(k) for k, _ in PHYSICS]
+
+
+def num(v, key=""):
+    # Nearest pose is judged against bars of 0.012 and 0.015 of height: a third decimal hides
+    # which side of the bar a value falls on.
+    digits = 4 if key == "nearest_pose" else 3
+    return "-" if v is None else f"{v:.{digits}f}"
 
 
 def sample(bindir, model, folder, skeleton, out, n, frames, steps, sampler, seed):
@@ -148,7 +153,7 @@ def main():
                 base = m["baselines"]
                 for key, text in [("clips", "clips, leave-one-out"), ("mean_pose", "static mean pose"), ("random_crops", "random crops")]:
                     b = dict(base[key])
-                    print(row([name, text] + [("-" if b.get(k) is None else f"{b[k]:.3f}") if k in b else "" for k, _ in METRICS] + [""] * len(PHYSICS)), flush=True)
+                    print(row([name, text] + [num(b.get(k), k) if k in b else "" for k, _ in METRICS] + [""] * len(PHYSICS)), flush=True)
             print(row([name, label] + cells(m)), flush=True)
     if args.steps_table and models:
         label, model = models[0]

@@ -21,7 +21,7 @@ use crate::diffusion::{DiffusionError, Schedule};
 use crate::document::AnyTopSection;
 use crate::motion::Motion;
 use crate::nn::{batch_from, BatchItem, Denoiser, NnError};
-use crate::repr::anytop::{AnyTopError, AnyTopStats};
+use crate::repr::anytop::{AnyTopError, AnyTopStats, RigError};
 use crate::repr::Features;
 use crate::rng::gaussian;
 use crate::rng::SplitMix64;
@@ -52,6 +52,8 @@ pub enum DiftError {
     /// Encoding or normalising a clip; `what` names it.
     #[error("{what}")]
     Repr { what: String, source: AnyTopError },
+    #[error(transparent)]
+    Rig(#[from] RigError),
     #[error("{file}")]
     Condition { file: String, source: DiffusionError },
     #[error(transparent)]
@@ -206,8 +208,7 @@ pub fn prepare(info: &CheckpointInfo, skeleton: &Skeleton, motion: &Motion, file
     if motion.frames < 2 {
         return Err(DiftError::Invalid(format!("{file}: {} frame(s); DIFT features need a motion of at least 2 frames", motion.frames)));
     }
-    let section =
-        AnyTopSection::of_clip(skeleton, motion, file).map_err(|source| DiftError::Repr { what: format!("{file}: cannot build an AnyTop rig"), source })?;
+    let section = AnyTopSection::of_clip(skeleton, motion, file).map_err(|source| RigError { name: file.to_string(), source })?;
     let features = section.rig.encode(skeleton, motion).map_err(DiftError::repr(file))?.features;
     prepare_encoded(info, skeleton, &section.rest_row, features, file)
 }

@@ -229,7 +229,7 @@ fn the_loss_weighting_is_recorded_and_kept_on_resume() {
 }
 
 /// `--init DIR` starts a new run from that model's weights, size and noise schedule, with the
-/// fine-tune defaults (--lr 3e-4, --augment 0) and a note of where it started; `--init
+/// fine-tune defaults (--lr 1e-3, --batch 4, --crop 20, --augment 0), kept by --resume, and a note of where it started; `--init
 /// builtin` does the same from the model inside the binaries; `--minutes` ends a run on time
 /// with a checkpoint; bad starts are one-line errors that write nothing.
 #[test]
@@ -272,12 +272,22 @@ fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
     let sw = load(scratch.clone());
     assert!(bw.iter().any(|(n, w)| flat(w) != flat(&sw[n])), "a run from scratch equals the base model");
 
-    // The fine-tune defaults, recorded.
+    // The fine-tune defaults, recorded; --resume goes on with them (no note of a difference),
+    // not with a new run's (--batch 16, --crop 40, --lr 1e-4, --augment 2/3).
     let defaults = dir.join("defaults");
-    let args: Vec<&str> = one.iter().map(|a| if *a == s(&tuned) { s(&defaults) } else { a }).collect();
-    ok(&run("mo-train", &args, None), "init defaults");
+    let args = [s(&data[1]), "--out", s(&defaults), "--checkpoint-minutes", "1000"];
+    ok(&run("mo-train", &[args.as_slice(), &["--init", s(&base), "--steps", "1"]].concat(), None), "init defaults");
     let d = info(&defaults);
-    assert_eq!((d["lr"].as_f64(), d["augment"].as_f64()), (Some(3e-4), Some(0.0)));
+    let settings = |d: &serde_json::Value| (d["lr"].as_f64(), d["augment"].as_f64(), d["batch"].as_u64(), d["crop"].as_u64());
+    assert_eq!(settings(&d), (Some(1e-3), Some(0.0), Some(4), Some(20)));
+    let resumed = run("mo-train", &[args.as_slice(), &["--steps", "2", "--resume"]].concat(), None);
+    ok(&resumed, "resume a fine-tune");
+    let stderr = String::from_utf8_lossy(&resumed.stderr);
+    assert!(!stderr.contains("differ from the checkpoint's"), "a resumed fine-tune changed its settings: {stderr}");
+    assert_eq!((info(&defaults)["step"].as_u64(), settings(&info(&defaults))), (Some(2), settings(&d)));
+    let changed = run("mo-train", &[args.as_slice(), &["--steps", "3", "--resume", "--batch", "8"]].concat(), None);
+    ok(&changed, "resume with another batch");
+    assert!(String::from_utf8_lossy(&changed.stderr).contains("differ from the checkpoint's"), "{}", String::from_utf8_lossy(&changed.stderr));
 
     // The built-in model, for a wall-time budget: it stops on time, saves, and samples.
     let builtin = dir.join("builtin");
