@@ -5,13 +5,13 @@ paper\t''"
 complete -c mo-train -l steps -d 'Training steps in total (a resumed run counts the steps already done) [default: 10000, or no limit with --minutes]' -r
 complete -c mo-train -l minutes -d 'Train for this much wall time (this invocation\'s), then save and stop; with --steps, whichever comes first. The progress bar then shows the time left' -r
 complete -c mo-train -l init -d 'anytop: start from a trained model instead of random weights: \'builtin\' (the model inside the binaries) or a model directory written by mo-train (use ./builtin for a directory of that name). A new run only: with --resume the checkpoint in --out goes on' -r -F
-complete -c mo-train -l batch -d 'Crops per step' -r
-complete -c mo-train -l crop -d 'Crop length in frames (default 40 for anytop; for sata the preset\'s window, 32 for small, which then is also the model\'s inference window)' -r
+complete -c mo-train -l batch -d 'Crops per step [default: 16; with --init 4]' -r
+complete -c mo-train -l crop -d 'Crop length in frames (default 40 for anytop, with --init 20; for sata the preset\'s window, 32 for small, which then is also the model\'s inference window)' -r
 complete -c mo-train -l arch -d 'What to train: anytop (the diffusion model behind mo-sample, mo-dift and mo-segment) or sata (the topology-agnostic autoencoder behind mo-encode --latent and mo-retarget --method latent)' -r -f -a "anytop\t''
 sata\t''"
 complete -c mo-train -l lambda-kl -d 'sata: weight of the KL term that keeps the latent near a unit Gaussian' -r
 complete -c mo-train -l lambda-cycle -d 'sata: weight of the cross-skeleton latent cycle (a motion\'s latent decoded onto another training skeleton and encoded again should come back). Default 0 for a new run (tried at 1 for 1,100 steps: transfers moved less, models/zoo-sata/MODEL_CARD.md); a resumed run keeps its checkpoint\'s unless this is given' -r
-complete -c mo-train -l lr -d 'Learning rate [default: 1e-4; with --init 3e-4]' -r
+complete -c mo-train -l lr -d 'Learning rate [default: 1e-4; with --init 1e-3]' -r
 complete -c mo-train -l lambda-geo -d 'Weight of the geodesic rotation loss (the angle, in radians, between predicted and true joint rotations) next to the MSE; the reference trains with 1' -r
 complete -c mo-train -l lambda-vel -d 'Weight of a velocity loss next to the MSE: the squared error of the prediction\'s frame-to-frame changes against the motion\'s (normalised units; MDM\'s, not in AnyTop\'s reference). 0 = off. Not kept in the checkpoint: give it again with --resume' -r
 complete -c mo-train -l augment -d 'Chance that a training draw uses an augmented skeleton (joints removed or added), as a number in [0, 1] or a fraction like 2/3 [default: 2/3; with --init 0]' -r
