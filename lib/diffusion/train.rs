@@ -327,6 +327,11 @@ pub struct StepDraw {
 /// afresh each step. Measured quietly (BENCHMARKS.md, "Sub-batches") only against no split: 4
 /// against 8 was compared under load only, and why one thread got faster as well is not
 /// established.
+///
+/// A step of one skeleton alone (a fine-tune on one creature's clips) is cut in at least two
+/// when it has two crops or more: at the fine-tune's batch of 4, one sub-batch of 4 left the
+/// second core idle (a chicken fine-tune ran 3.6 steps/s on two threads, about what one thread
+/// gives).
 pub const MAX_SUB_BATCH: usize = 4;
 
 /// `items` in order, cut into the fewest runs of at most `most` items, of near-equal length
@@ -342,10 +347,20 @@ fn split_evenly(items: Vec<usize>, most: usize) -> Vec<Vec<usize>> {
 /// groups into sub-batches (`MAX_SUB_BATCH`), and draw each sub-batch's noise (see
 /// `StepDraw`).
 pub fn draw_step(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batch: usize, crop: usize) -> Result<StepDraw, NnError> {
-    draw_split(set, schedule, rng, batch, crop, MAX_SUB_BATCH)
+    draw_split(set, schedule, rng, batch, crop, MAX_SUB_BATCH, true)
 }
 
-fn draw_split(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batch: usize, crop: usize, most: usize) -> Result<StepDraw, NnError> {
+/// `draw_step` with sub-batches of at most `most` crops; `lone_in_two`: a step of one group
+/// is cut in at least two.
+fn draw_split(
+    set: &TrainSet,
+    schedule: &Schedule,
+    rng: &mut SplitMix64,
+    batch: usize,
+    crop: usize,
+    most: usize,
+    lone_in_two: bool,
+) -> Result<StepDraw, NnError> {
     let crops = set.sample(rng, batch, crop);
     let steps: Vec<u32> = (0..batch).map(|_| rng.below(schedule.len()) as u32).collect();
     let mut order: Vec<(usize, Option<usize>)> = Vec::new();
@@ -357,6 +372,7 @@ fn draw_split(set: &TrainSet, schedule: &Schedule, rng: &mut SplitMix64, batch: 
     if order.is_empty() {
         return Err(NnError::Shape { what: "training batch", expected: "at least one crop".into(), got: vec![0] });
     }
+    let most = if lone_in_two && order.len() == 1 { most.min(crops.len().div_ceil(2)) } else { most };
     let (mut tokens, mut pairs, mut velocity) = (0usize, 0usize, true);
     let mut dims = 0;
     let mut groups = Vec::with_capacity(order.len());
@@ -902,6 +918,22 @@ mod tests {
     }
 
     #[test]
+    fn a_lone_skeletons_small_batch_is_cut_in_two() {
+        let (skeleton, motion) = crate::synth::creature("quadruped", 1).unwrap();
+        let clips = vec![Clip { name: "q.bvh".into(), skeleton, motion }];
+        let set = TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &Augmentation::none()).unwrap().0;
+        let schedule = Schedule::cosine(100);
+        let sizes = |batch: usize| -> Vec<usize> {
+            draw_step(&set, &schedule, &mut SplitMix64::new(3), batch, 12).unwrap().groups.iter().map(|g| g.crops.len()).collect()
+        };
+        // The fine-tune's batch of 4 gives both cores work; one crop stays one.
+        assert_eq!(sizes(4), vec![2, 2]);
+        assert_eq!(sizes(3), vec![2, 1]);
+        assert_eq!(sizes(1), vec![1]);
+        assert_eq!(sizes(16), vec![4, 4, 4, 4]);
+    }
+
+    #[test]
     fn splitting_a_skeletons_crops_into_sub_batches_changes_neither_loss_nor_gradient() {
         let (skeleton, motion) = crate::synth::creature("quadruped", 1).unwrap();
         let clips = vec![Clip { name: "q.bvh".into(), skeleton, motion }];
@@ -913,7 +945,7 @@ mod tests {
         let sizes: Vec<usize> = draw.groups.iter().map(|g| g.crops.len()).collect();
         assert!(sizes.len() > 1 && sizes.iter().all(|&n| n <= MAX_SUB_BATCH) && sizes.iter().sum::<usize>() == batch, "{sizes:?}");
         // The same step as one group, and that group cut by hand into the same parts.
-        let whole = draw_split(&set, &schedule, &mut SplitMix64::new(3), batch, 12, usize::MAX).unwrap();
+        let whole = draw_split(&set, &schedule, &mut SplitMix64::new(3), batch, 12, usize::MAX, false).unwrap();
         assert_eq!(whole.groups.len(), 1);
         let g = &whole.groups[0];
         assert_eq!(g.shape.1, 13, "every crop is full length, so the parts keep the group's shape");
