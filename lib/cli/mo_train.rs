@@ -212,7 +212,7 @@ fn catch_interrupts() -> anyhow::Result<()> {
 
 /// A fine-tune's (`--init`) settings when none are given: many small steps. On one real clip
 /// of a skeleton the built-in model never saw, a thousand steps brought a chicken's poses to
-/// within 0.012 of its clip's, where 270 steps of batch 16 left them at 0.019; crops of 20
+/// within 0.012 of its clip's, where 268 steps of batch 16 left them at 0.015; crops of 20
 /// frames cost half of 40's per step and did as well per step (models/zoo-small/MODEL_CARD.md).
 pub const INIT_LR: f64 = 1e-3;
 pub const INIT_BATCH: u64 = 4;

@@ -917,12 +917,18 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_lone_skeletons_small_batch_is_cut_in_two() {
+    /// One synthetic quadruped clip, unaugmented, and AnyTop's schedule: a set whose every step
+    /// is one skeleton's group.
+    fn one_quadruped() -> (TrainSet, Schedule) {
         let (skeleton, motion) = crate::synth::creature("quadruped", 1).unwrap();
         let clips = vec![Clip { name: "q.bvh".into(), skeleton, motion }];
         let set = TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &Augmentation::none()).unwrap().0;
-        let schedule = Schedule::cosine(100);
+        (set, Schedule::cosine(100))
+    }
+
+    #[test]
+    fn a_lone_skeletons_small_batch_is_cut_in_two() {
+        let (set, schedule) = one_quadruped();
         let sizes = |batch: usize| -> Vec<usize> {
             draw_step(&set, &schedule, &mut SplitMix64::new(3), batch, 12).unwrap().groups.iter().map(|g| g.crops.len()).collect()
         };
@@ -935,10 +941,7 @@ mod tests {
 
     #[test]
     fn splitting_a_skeletons_crops_into_sub_batches_changes_neither_loss_nor_gradient() {
-        let (skeleton, motion) = crate::synth::creature("quadruped", 1).unwrap();
-        let clips = vec![Clip { name: "q.bvh".into(), skeleton, motion }];
-        let set = TrainSet::build(clips, NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &Augmentation::none()).unwrap().0;
-        let schedule = Schedule::cosine(100);
+        let (set, schedule) = one_quadruped();
         // One skeleton, more crops than a sub-batch takes: the step splits it.
         let batch = MAX_SUB_BATCH + 3;
         let draw = draw_step(&set, &schedule, &mut SplitMix64::new(3), batch, 12).unwrap();
