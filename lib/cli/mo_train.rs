@@ -62,7 +62,8 @@ EXAMPLES:
 /// directory for mo-sample, mo-dift and mo-segment --model.
 ///
 /// --resume continues with the checkpoint's --lr, --batch, --crop and --augment unless they
-/// are given, so a fine-tune resumes as a fine-tune.
+/// are given, so a fine-tune resumes as a fine-tune; given ones are recorded in the
+/// checkpoint, and the next --resume goes on with them.
 #[derive(clap::Parser, Debug)]
 #[command(name = "mo-train", version, after_long_help = EXAMPLES)]
 pub struct Args {

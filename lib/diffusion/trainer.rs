@@ -441,6 +441,12 @@ impl AnyTopTrainer {
             info.weighting = weighting;
         }
         let schedule = info.schedule();
+        // The checkpoint describes the run that wrote it last (as SATA's does): a resumed run
+        // with another --lr, --batch or --crop records them, so the next --resume goes on
+        // with them.
+        info.lr = opts.lr;
+        info.batch = opts.batch;
+        info.crop = opts.crop;
         info.augment = opts.augment;
         info.augment_variants = opts.augment_variants;
         info.skeletons = set

@@ -288,6 +288,7 @@ fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
     let changed = run("mo-train", &[args.as_slice(), &["--steps", "3", "--resume", "--batch", "8"]].concat(), None);
     ok(&changed, "resume with another batch");
     assert!(String::from_utf8_lossy(&changed.stderr).contains("differ from the checkpoint's"), "{}", String::from_utf8_lossy(&changed.stderr));
+    assert_eq!(settings(&info(&defaults)), (Some(1e-3), Some(0.0), Some(8), Some(20)), "the checkpoint records the resumed run's batch");
 
     // The built-in model, for a wall-time budget: it stops on time, saves, and samples.
     let builtin = dir.join("builtin");
