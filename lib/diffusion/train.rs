@@ -330,8 +330,8 @@ pub struct StepDraw {
 ///
 /// A step of one skeleton alone (a fine-tune on one creature's clips) is cut in at least two
 /// when it has two crops or more: at the fine-tune's batch of 4, one sub-batch of 4 left the
-/// second core idle (a chicken fine-tune ran 3.6 steps/s on two threads, about what one thread
-/// gives).
+/// second core idle (a chicken fine-tune ran 3.2-3.5 steps/s on two threads, about what one
+/// thread gives; BENCHMARKS.md, "A fine-tune's lone batch in two").
 pub const MAX_SUB_BATCH: usize = 4;
 
 /// `items` in order, cut into the fewest runs of at most `most` items, of near-equal length
