@@ -29,6 +29,7 @@ METRICS = [
     ("calibrated_coverage", "cal. coverage %"),
     ("duty_factor", "duty"),
     ("mixed_contact", "mixed contact"),
+    ("alternation", "alternation"),
     ("coverage", "coverage %"),
     ("local_diversity", "local div"),
     ("inter_diversity", "inter div"),

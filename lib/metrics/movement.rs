@@ -18,7 +18,12 @@
 //!   statue covers only windows that are themselves about still;
 //! * foot contact: duty factor (the share of frames a foot is down) and the share of frames
 //!   in which some feet are down and others up (0 for a statue and for a hopping bird, high
-//!   for a walk).
+//!   for a walk);
+//! * alternation: how much of the feet's horizontal motion (root-relative, in the creature's
+//!   facing frame) is opposed rather than shared. A walk swings left against right, so about
+//!   0.6-0.8; feet that all swing together score near 0, feet that move independently 0.5.
+//!   Mixed contact cannot see this: feet lifted together at odd times still give some up and
+//!   some down.
 //!
 //! Every loop over frames or windows is bounded by caps on the reference frames and windows
 //! (strided evenly), so a 15,000-frame capture scores in seconds; every result is the same at
@@ -80,6 +85,10 @@ pub struct Movement {
     /// Share of frames with some feet down and some up, mean over motions (`None`: fewer
     /// than two feet).
     pub mixed_contact: Option<f64>,
+    /// Share of the feet's horizontal motion that is opposed rather than shared (`alternation`),
+    /// pooled over the motions by how long and how much their feet move (`None`: fewer than
+    /// two feet, or no motion moves them).
+    pub alternation: Option<f64>,
 }
 
 /// A skeleton's clips, prepared once: world clips for energy, contact and poses, AnyTop point
@@ -159,6 +168,85 @@ pub fn contact_stats(clip: &WorldClip, opts: &PhysicsOptions) -> (Option<f64>, O
         n > 0 && n < rows.len()
     });
     (Some(duty), Some(mixed.count() as f64 / clip.frames as f64))
+}
+
+/// Share of the feet's horizontal motion that is opposed rather than shared. For a pair of feet
+/// (a, b), with q the feet's horizontal (x, z) point-clip positions (root-relative, in the
+/// facing frame for AnyTop features), D = the RMS over frames of (q_a - q_b) about its mean and
+/// S = the same of (q_a + q_b). Each foot is paired with the foot it swings most against
+/// (largest D / (D + S)): in a walk that is its mate on the other side, and the front-hind and
+/// diagonal pairs, a quarter cycle apart, would only dilute the number. The result is ΣD /
+/// Σ(D + S) over those pairs: 1 when every foot swings against a partner, 0 when all feet
+/// swing together, 0.5 for feet a quarter cycle apart. `feet` are joint indices; the point clip holds joints 1.. (the root is not a
+/// point). `None` with fewer than two feet inside the clip or when the feet do not move.
+pub fn alternation(points: &PointClip, feet: &[usize]) -> Option<f64> {
+    alternation_parts(points, feet).map(|(opposed, total)| opposed / total)
+}
+
+/// ΣD and Σ(D + S) of `alternation`, each times the frames, so that several motions pool by
+/// how long and how much their feet move (an idle clip's feet, which barely sway together,
+/// then count for little); `None` where `alternation` is.
+fn alternation_parts(points: &PointClip, feet: &[usize]) -> Option<(f64, f64)> {
+    let idx: Vec<usize> = feet.iter().filter(|&&j| j >= 1 && j <= points.points()).map(|&j| j - 1).collect();
+    let frames = points.frames();
+    if idx.len() < 2 || frames < 2 {
+        return None;
+    }
+    let at = |f: usize, p: usize| {
+        let v = &points.frame(f)[3 * p..3 * p + 3];
+        [v[0], v[2]]
+    };
+    // RMS about the mean of a series of 2-D vectors.
+    let spread = |series: &dyn Fn(usize) -> [f64; 2]| {
+        let mean = (0..frames).fold([0.0, 0.0], |m, f| {
+            let v = series(f);
+            [m[0] + v[0] / frames as f64, m[1] + v[1] / frames as f64]
+        });
+        let sq: f64 = (0..frames)
+            .map(|f| {
+                let v = series(f);
+                (v[0] - mean[0]).powi(2) + (v[1] - mean[1]).powi(2)
+            })
+            .sum();
+        (sq / frames as f64).sqrt()
+    };
+    // D and S of every pair, then each foot's most opposed partner.
+    let mut pair = vec![vec![(0.0, 0.0); idx.len()]; idx.len()];
+    for (i, &a) in idx.iter().enumerate() {
+        for (k, &b) in idx.iter().enumerate().skip(i + 1) {
+            let d = spread(&|f| {
+                let (p, q) = (at(f, a), at(f, b));
+                [p[0] - q[0], p[1] - q[1]]
+            });
+            let s = spread(&|f| {
+                let (p, q) = (at(f, a), at(f, b));
+                [p[0] + q[0], p[1] + q[1]]
+            });
+            pair[i][k] = (d, s);
+            pair[k][i] = (d, s);
+        }
+    }
+    let (mut opposed, mut total) = (0.0, 0.0);
+    for (i, row) in pair.iter().enumerate() {
+        let share = |&(d, s): &(f64, f64)| if d + s > 0.0 { d / (d + s) } else { -1.0 };
+        let best = row.iter().enumerate().filter(|&(k, _)| k != i).map(|(_, p)| p).max_by(|p, q| share(p).total_cmp(&share(q)));
+        if let Some(&(d, s)) = best {
+            opposed += d;
+            total += d + s;
+        }
+    }
+    // Below a millionth of a mean bone (0.209 in AnyTop units) the feet stand still.
+    (total > 1e-6).then(|| (opposed * frames as f64, total * frames as f64))
+}
+
+/// One clip's part of the clips' baseline: nearest pose against the other clips, duty factor,
+/// mixed contact, alternation's parts.
+type ClipParts = (f64, Option<f64>, Option<f64>, Option<(f64, f64)>);
+
+/// Alternation over several motions: their `alternation_parts` pooled.
+fn pooled(parts: &[(f64, f64)]) -> Option<f64> {
+    let (opposed, total) = parts.iter().fold((0.0, 0.0), |(o, t), p| (o + p.0, t + p.1));
+    (!parts.is_empty()).then(|| opposed / total)
 }
 
 /// Every `stride`-th item so that at most `cap` remain (all when there are fewer).
@@ -316,6 +404,7 @@ impl<'a> Reference<'a> {
         let pose_sum: f64 = motions.iter().map(|c| self.nearest_pose(c, skip) * c.frames as f64).sum();
         let stats: Vec<(Option<f64>, Option<f64>)> = motions.iter().map(|c| contact_stats(c, &self.opts.contact)).collect();
         let mean_of = |v: Vec<f64>| if v.is_empty() { None } else { Some(v.iter().sum::<f64>() / v.len() as f64) };
+        let alternations: Vec<(f64, f64)> = motions.iter().zip(points).filter_map(|(c, p)| alternation_parts(p, &c.feet)).collect();
         Ok(Movement {
             energy: mean,
             energy_ratio: ratio(mean),
@@ -324,6 +413,7 @@ impl<'a> Reference<'a> {
             calibrated_coverage: self.coverage(points, skip),
             duty_factor: mean_of(stats.iter().filter_map(|s| s.0).collect()),
             mixed_contact: mean_of(stats.iter().filter_map(|s| s.1).collect()),
+            alternation: pooled(&alternations),
         })
     }
 
@@ -337,18 +427,18 @@ impl<'a> Reference<'a> {
         }
         // Per clip, against the others: nearest pose and contact (coverage is the whole set's,
         // from the thresholds; energy is the clips' own).
-        let parts: Vec<(f64, Option<f64>, Option<f64>)> = self
+        let parts: Vec<ClipParts> = self
             .clips
             .iter()
             .enumerate()
             .map(|(i, c)| {
                 let (duty, mixed) = contact_stats(c, &self.opts.contact);
-                (self.nearest_pose(c, Some(i)), duty, mixed)
+                (self.nearest_pose(c, Some(i)), duty, mixed, alternation_parts(&self.points[i], &c.feet))
             })
             .collect();
         let weights: Vec<f64> = self.clips.iter().map(|c| c.frames as f64).collect();
         let total: f64 = weights.iter().sum();
-        let avg_opt = |f: &dyn Fn(&(f64, Option<f64>, Option<f64>)) -> Option<f64>| {
+        let avg_opt = |f: &dyn Fn(&ClipParts) -> Option<f64>| {
             let v: Vec<(f64, f64)> = parts.iter().zip(&weights).filter_map(|(m, w)| f(m).map(|x| (x, *w))).collect();
             if v.is_empty() {
                 None
@@ -369,6 +459,7 @@ impl<'a> Reference<'a> {
             calibrated_coverage: self.coverage_leave_one_out(),
             duty_factor: avg_opt(&|p| p.1),
             mixed_contact: avg_opt(&|p| p.2),
+            alternation: pooled(&parts.iter().filter_map(|p| p.3).collect::<Vec<_>>()),
         })
     }
 
@@ -483,6 +574,48 @@ mod tests {
         // The walk itself alternates its feet.
         let own = r.clips_baseline().unwrap();
         assert!(own.mixed_contact.unwrap() > 0.3, "{own:?}");
+        // A statue's feet do not move, so they neither alternate nor swing together.
+        assert_eq!(m.alternation, None);
+        assert!(own.alternation.unwrap() > 0.6, "{own:?}");
+        // Pooled, a motion whose feet barely move counts for little: the walk next to a clip
+        // whose two feet sway together by a ten-thousandth of a unit is still a walk.
+        let (clip, points) = (&clips[0], &pts[0]);
+        let walk_alt = alternation(points, &clip.feet).unwrap();
+        let both = pooled(&[
+            alternation_parts(points, &clip.feet).unwrap(),
+            alternation_parts(&two_feet(points.frames(), |f| 1e-4 * f.sin(), |f| 1e-4 * f.sin()), &[1, 2]).unwrap(),
+        ])
+        .unwrap();
+        assert!((both - walk_alt).abs() < 0.01, "{both} vs {walk_alt}");
+    }
+
+    /// Two feet (joints 1 and 2 under a root at 0) whose fore-aft positions are `a(f)` and
+    /// `b(f)`, as a point clip.
+    fn two_feet(frames: usize, a: impl Fn(f64) -> f64, b: impl Fn(f64) -> f64) -> PointClip {
+        let values = (0..frames).flat_map(|f| [0.2, -1.0, a(f as f64), -0.2, -1.0, b(f as f64)]).collect();
+        PointClip::new(frames, 6, values).unwrap()
+    }
+
+    #[test]
+    fn alternation_tells_opposed_feet_from_feet_that_swing_together() {
+        let phase = |f: f64| (std::f64::consts::TAU * f / 30.0).sin();
+        let feet = [1, 2];
+        // Left against right, as in a walk: all of the motion is opposed.
+        let walk = two_feet(120, phase, |f| -phase(f));
+        assert!((alternation(&walk, &feet).unwrap() - 1.0).abs() < 1e-12);
+        // Both feet forward and back together, as the zoo-tiny quadruped's legs did.
+        let together = two_feet(120, phase, phase);
+        assert!(alternation(&together, &feet).unwrap() < 1e-12);
+        // A quarter cycle apart: as much shared as opposed.
+        let quarter = two_feet(120, phase, |f| phase(f + 7.5));
+        assert!((alternation(&quarter, &feet).unwrap() - 0.5).abs() < 1e-9, "{:?}", alternation(&quarter, &feet));
+        // Feet that stand still, one foot, or a foot outside the clip: nothing to measure.
+        assert_eq!(alternation(&two_feet(120, |_| 0.3, |_| -0.1), &feet), None);
+        assert_eq!(alternation(&walk, &[1]), None);
+        assert_eq!(alternation(&walk, &[1, 9]), None);
+        // Vertical motion (lifting the feet) does not count: only the horizontal swing.
+        let lift = PointClip::new(60, 6, (0..60).flat_map(|f| [0.2, phase(f as f64), 0.0, -0.2, phase(f as f64), 0.0]).collect()).unwrap();
+        assert_eq!(alternation(&lift, &feet), None);
     }
 
     /// A hip that stays put and a foot swinging under it at `hz`, 30 fps.
