@@ -236,7 +236,7 @@ fn alternation_parts(points: &PointClip, feet: &[usize]) -> Option<(f64, f64)> {
         }
     }
     // Below a millionth of a mean bone (0.209 in AnyTop units) the feet stand still.
-    (total > 1e-6).then(|| (opposed * frames as f64, total * frames as f64))
+    (total > 1e-6).then_some((opposed * frames as f64, total * frames as f64))
 }
 
 /// One clip's part of the clips' baseline: nearest pose against the other clips, duty factor,
