@@ -51,7 +51,12 @@ impl Ema {
                 Some(e) => ((e * d)? + (w * (1.0 - d))?)?,
                 None => w.copy()?,
             };
-            self.weights.insert(name.clone(), next);
+            // Detached: arithmetic on a variable records its inputs for backprop, so without
+            // this each average would hold the previous one and its two temporaries, a chain
+            // as long as the run. It grew zoo-tiny's training process by about 0.6 MB a step
+            // (12 GB after 20,000 steps) until the kernel's OOM killer stopped a second run
+            // beside it.
+            self.weights.insert(name.clone(), next.detach());
         }
         Ok(())
     }
@@ -82,6 +87,18 @@ mod tests {
         let ema = Ema::new(0.9, &vars).unwrap();
         v.set(&Tensor::new(&[5.0f32, 6.0], &Device::Cpu).unwrap()).unwrap();
         assert_eq!(values(&ema.weights()["a"]), vec![1.0, 2.0]);
+    }
+
+    #[test]
+    fn the_average_keeps_no_history() {
+        let v = var(&[1.0, 2.0]);
+        let vars = BTreeMap::from([("a".to_string(), v.clone())]);
+        let mut ema = Ema::new(0.9, &vars).unwrap();
+        for step in 0..3 {
+            ema.update(&vars, step).unwrap();
+            // A tensor that tracks no op holds no reference to the averages before it.
+            assert!(!ema.weights()["a"].track_op(), "step {step}: the average records its inputs");
+        }
     }
 
     #[test]
