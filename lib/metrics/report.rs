@@ -270,7 +270,7 @@ pub fn generation_report(gt: &[Clip], gen: &[Clip], section: &AnyTopSection, opt
             ("threshold", "mean joint distance, AnyTop units (a quantile of the clips' own nearest-window distances)"),
             ("duty_factor", "share of frames a foot is in contact"),
             ("mixed_contact", "share of frames with some feet down and some up"),
-            ("alternation", "share of the feet's horizontal motion that is opposed, not shared (0.5: independent feet)"),
+            ("alternation", "share of the feet's horizontal swing that is against a partner foot, not with it (1: a walk's left against right, 0: all together)"),
             ("local_diversity", "mean joint distance, AnyTop units (mean SMPL bone = 0.209)"),
             ("global_diversity", "mean joint distance per frame, AnyTop units"),
             ("inter_diversity", "mean joint distance, AnyTop units"),
