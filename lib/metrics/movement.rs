@@ -21,7 +21,7 @@
 //!   for a walk);
 //! * alternation: how much of the feet's horizontal motion (root-relative, in the creature's
 //!   facing frame) is opposed rather than shared. A walk swings left against right, so about
-//!   0.6-0.8; feet that all swing together score near 0, feet that move independently 0.5.
+//!   0.6-0.8; feet that all swing together score near 0, feet a quarter cycle apart 0.5.
 //!   Mixed contact cannot see this: feet lifted together at odd times still give some up and
 //!   some down.
 //!
