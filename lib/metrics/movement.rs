@@ -177,8 +177,9 @@ pub fn contact_stats(clip: &WorldClip, opts: &PhysicsOptions) -> (Option<f64>, O
 /// (largest D / (D + S)): in a walk that is its mate on the other side, and the front-hind and
 /// diagonal pairs, a quarter cycle apart, would only dilute the number. The result is ΣD /
 /// Σ(D + S) over those pairs: 1 when every foot swings against a partner, 0 when all feet
-/// swing together, 0.5 for feet a quarter cycle apart. `feet` are joint indices; the point clip holds joints 1.. (the root is not a
-/// point). `None` with fewer than two feet inside the clip or when the feet do not move.
+/// swing together, 0.5 for feet a quarter cycle apart. `feet` are joint indices; the point
+/// clip holds joints 1.. (the root is not a point). `None` with fewer than two feet inside the
+/// clip or when the feet do not move.
 pub fn alternation(points: &PointClip, feet: &[usize]) -> Option<f64> {
     alternation_parts(points, feet).map(|(opposed, total)| opposed / total)
 }
@@ -192,38 +193,27 @@ fn alternation_parts(points: &PointClip, feet: &[usize]) -> Option<(f64, f64)> {
     if idx.len() < 2 || frames < 2 {
         return None;
     }
-    let at = |f: usize, p: usize| {
-        let v = &points.frame(f)[3 * p..3 * p + 3];
-        [v[0], v[2]]
-    };
-    // RMS about the mean of a series of 2-D vectors.
-    let spread = |series: &dyn Fn(usize) -> [f64; 2]| {
-        let mean = (0..frames).fold([0.0, 0.0], |m, f| {
-            let v = series(f);
-            [m[0] + v[0] / frames as f64, m[1] + v[1] / frames as f64]
-        });
-        let sq: f64 = (0..frames)
-            .map(|f| {
-                let v = series(f);
-                (v[0] - mean[0]).powi(2) + (v[1] - mean[1]).powi(2)
-            })
-            .sum();
+    // Each foot's horizontal path about its own mean: the mean of q_a ± q_b is then removed
+    // already, so D and S are plain RMS values of sums and differences.
+    let centred: Vec<Vec<[f64; 2]>> = idx
+        .iter()
+        .map(|&p| {
+            let path: Vec<[f64; 2]> = (0..frames).map(|f| [points.frame(f)[3 * p], points.frame(f)[3 * p + 2]]).collect();
+            let mean = path.iter().fold([0.0, 0.0], |m, v| [m[0] + v[0] / frames as f64, m[1] + v[1] / frames as f64]);
+            path.iter().map(|v| [v[0] - mean[0], v[1] - mean[1]]).collect()
+        })
+        .collect();
+    let rms = |a: &[[f64; 2]], b: &[[f64; 2]], sign: f64| {
+        let sq: f64 = a.iter().zip(b).map(|(p, q)| (p[0] + sign * q[0]).powi(2) + (p[1] + sign * q[1]).powi(2)).sum();
         (sq / frames as f64).sqrt()
     };
     // D and S of every pair, then each foot's most opposed partner.
     let mut pair = vec![vec![(0.0, 0.0); idx.len()]; idx.len()];
-    for (i, &a) in idx.iter().enumerate() {
-        for (k, &b) in idx.iter().enumerate().skip(i + 1) {
-            let d = spread(&|f| {
-                let (p, q) = (at(f, a), at(f, b));
-                [p[0] - q[0], p[1] - q[1]]
-            });
-            let s = spread(&|f| {
-                let (p, q) = (at(f, a), at(f, b));
-                [p[0] + q[0], p[1] + q[1]]
-            });
-            pair[i][k] = (d, s);
-            pair[k][i] = (d, s);
+    for i in 0..idx.len() {
+        for k in i + 1..idx.len() {
+            let ds = (rms(&centred[i], &centred[k], -1.0), rms(&centred[i], &centred[k], 1.0));
+            pair[i][k] = ds;
+            pair[k][i] = ds;
         }
     }
     let (mut opposed, mut total) = (0.0, 0.0);
