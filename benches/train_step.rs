@@ -126,6 +126,7 @@ fn main() {
         lambda_vel: 0.0,
         ema: 0.999,
         noise_shift: None,
+        position_jitter: None,
         weighting: None,
         augment: 0.0,
         augment_variants: 0,

@@ -152,6 +152,12 @@ pub struct Args {
     /// its model's, unless this is given].
     #[arg(long, value_name = "W")]
     pub loss_weighting: Option<crate::diffusion::train::Weighting>,
+    /// anytop: start each training crop's temporal positions at a random offset from 0 to N,
+    /// so the model sees the positions of samples up to N + --crop frames long; without it
+    /// (0) a longer sample's motion fades past the crop length [default: 1000 for a new run or
+    /// a fine-tune; a resumed run keeps its checkpoint's, unless this is given].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
+    pub position_jitter: Option<u64>,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
@@ -301,6 +307,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         augment_variants: args.augment_variants as usize,
         ema: args.ema,
         noise_shift: args.noise_shift,
+        position_jitter: args.position_jitter.map(|n| n as usize),
         weighting: args.loss_weighting,
     };
     // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.

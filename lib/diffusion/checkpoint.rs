@@ -118,6 +118,10 @@ pub struct CheckpointInfo {
     /// before it existed.
     #[serde(default = "no_shift")]
     pub noise_shift: f64,
+    /// Training crops' temporal positions started at a random offset in `0..=position_jitter`
+    /// (`data::Crop::position`); 0 in checkpoints written before it existed (every crop at 0).
+    #[serde(default)]
+    pub position_jitter: usize,
     /// How the diffusion steps weighed in the loss (`train::Weighting`); x0 in checkpoints
     /// written before it existed.
     #[serde(default = "plain_x0", skip_serializing_if = "is_plain_x0")]

@@ -96,6 +96,9 @@ pub struct TrainSet {
     pub augment_probability: f64,
     /// Augmented variants that could not be prepared, with the reason.
     pub skipped_variants: Vec<String>,
+    /// A crop's temporal positions start at a random offset in `0..=position_jitter` (0: every
+    /// crop starts at 0), drawn apart from where the crop lies in its clip; see `Crop::position`.
+    pub position_jitter: usize,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -349,7 +352,7 @@ impl TrainSet {
         if skeletons.is_empty() {
             return Err(DataError::TooShort { clip: first_short.unwrap_or_default() });
         }
-        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants }, dropped))
+        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants, position_jitter: 0 }, dropped))
     }
 
     /// The skeleton (original or augmented variant) a crop comes from.
@@ -391,7 +394,8 @@ impl TrainSet {
 
     /// Draw `batch` crops of at most `frames` feature frames: a skeleton uniformly (each gets
     /// 1/#skeletons, AnyTop's balancing sampler), with `augment_probability` one of its
-    /// augmented variants (uniformly) instead, a clip of it uniformly, a crop start uniformly.
+    /// augmented variants (uniformly) instead, a clip of it uniformly, a crop start uniformly,
+    /// and with `position_jitter` a position offset uniformly.
     pub fn sample(&self, rng: &mut SplitMix64, batch: usize, frames: usize) -> Vec<Crop> {
         (0..batch)
             .map(|_| {
@@ -411,7 +415,9 @@ impl TrainSet {
                 let clip = &sk.clips[c];
                 let len = clip.frames.min(frames);
                 let start = rng.below(clip.frames - len + 1);
-                Crop { skeleton: s, variant, clip: c, start, frames: len }
+                // No draw when the jitter is off, so such runs keep their old stream.
+                let position = if self.position_jitter > 0 { rng.below(self.position_jitter + 1) } else { 0 };
+                Crop { skeleton: s, variant, clip: c, start, frames: len, position }
             })
             .collect()
     }
@@ -433,6 +439,11 @@ pub struct Crop {
     pub clip: usize,
     pub start: usize,
     pub frames: usize,
+    /// The temporal position offset the model sees for the crop's first frame
+    /// (`BatchItem::start`). Independent of `start`: the position says nothing about the
+    /// motion, so the model learns to ignore it, while it sees every position up to
+    /// `position_jitter + frames`, the ones a longer sample uses.
+    pub position: usize,
 }
 
 #[cfg(test)]
@@ -595,6 +606,24 @@ mod tests {
         assert_eq!(share(&set), 1.0);
         aug.probability = 1.5;
         assert!(matches!(TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug), Err(DataError::Probability(_))));
+    }
+
+    /// Off, every crop sits at position 0 and the draw stream is the one runs had before the
+    /// jitter; on, positions spread over 0..=N apart from the crops, which stay the same.
+    #[test]
+    fn the_position_jitter_spreads_positions_and_leaves_the_crops() {
+        let names = NameTable::builtin().unwrap();
+        let (mut set, _) = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        let off = set.sample(&mut SplitMix64::new(5), 400, 40);
+        assert!(off.iter().all(|c| c.position == 0));
+        set.position_jitter = 100;
+        let on = set.sample(&mut SplitMix64::new(5), 400, 40);
+        assert!(on.iter().all(|c| c.position <= 100));
+        let distinct: std::collections::BTreeSet<usize> = on.iter().map(|c| c.position).collect();
+        assert!(distinct.len() > 60 && distinct.iter().any(|&p| p > 90) && distinct.iter().any(|&p| p < 10), "{distinct:?}");
+        // The first crop is drawn before any position, so it is the same with or without.
+        assert_eq!((on[0].skeleton, on[0].clip, on[0].start), (off[0].skeleton, off[0].clip, off[0].start));
+        assert_eq!(on, set.sample(&mut SplitMix64::new(5), 400, 40), "same seed, same positions");
     }
 
     #[test]

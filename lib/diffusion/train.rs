@@ -562,12 +562,15 @@ fn loss_sums(
         .zip(&features)
         .map(|(c, f)| {
             let s = set.data(c);
-            // Temporal positions count from the crop's first frame, as when sampling. The
-            // reference adds the crop's start in its clip: the model then learns what each clip
-            // does at each frame index, and from pure noise predicts the average of all clips
-            // at that index, which stands still (issue 22: a 1-skeleton proxy's samples moved
-            // with energy ratio 0.35 with the start added and 0.64 without, at noise shift 10).
-            BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 }
+            // Temporal positions count from the crop's random offset (`Crop::position`), not
+            // from its start in the clip as the reference's do: with the start the model learns
+            // what each clip does at each frame index, and from pure noise predicts the average
+            // of all clips at that index, which stands still (issue 22: a 1-skeleton proxy's
+            // samples moved with energy ratio 0.35 with the start added and 0.64 without, at
+            // noise shift 10). Without any offset, a sample longer than the crops reaches
+            // positions training never showed, and its motion fades after the crop length.
+            let start = u32::try_from(c.position).unwrap_or(u32::MAX);
+            BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start }
         })
         .collect();
     let clean = batch_from(&items, steps, device)?;

@@ -194,6 +194,43 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     assert!(!other.join("checkpoint.json").exists());
 }
 
+/// A new run records the default position jitter, a resumed run keeps its checkpoint's (0 for
+/// checkpoints written before it existed) unless it is given again, and the jitter changes
+/// what is learnt.
+#[test]
+fn the_position_jitter_is_recorded_and_kept_on_resume() {
+    let dir = tempdir("train-jitter");
+    let data = data(&dir);
+    let out = dir.join("model");
+    ok(&run("mo-train", &train_args(&data, &out, "2"), None), "new run");
+    assert_eq!(info(&out)["position_jitter"].as_u64(), Some(1000));
+    let mut args = train_args(&data, &out, "3");
+    args.extend(["--resume", "--position-jitter", "0"]);
+    ok(&run("mo-train", &args, None), "resume without jitter");
+    assert_eq!(info(&out)["position_jitter"].as_u64(), Some(0));
+    let mut args = train_args(&data, &out, "4");
+    args.push("--resume");
+    ok(&run("mo-train", &args, None), "resume");
+    assert_eq!(info(&out)["position_jitter"].as_u64(), Some(0));
+    // An old checkpoint (no field) resumes without jitter.
+    let path = out.join("checkpoint.json");
+    let mut old: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    old.as_object_mut().unwrap().remove("position_jitter");
+    std::fs::write(&path, serde_json::to_string(&old).unwrap()).unwrap();
+    let mut args = train_args(&data, &out, "5");
+    args.push("--resume");
+    ok(&run("mo-train", &args, None), "resume an old checkpoint");
+    assert_eq!(info(&out)["position_jitter"].as_u64(), Some(0));
+    // Two new runs that differ only in the jitter learn different weights.
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    ok(&run("mo-train", &train_args(&data, &a, "2"), None), "a");
+    let mut args = train_args(&data, &b, "2");
+    args.extend(["--position-jitter", "0"]);
+    ok(&run("mo-train", &args, None), "b");
+    let bytes = |d: &std::path::Path| std::fs::read(d.join("model.safetensors")).unwrap();
+    assert_ne!(bytes(&a), bytes(&b));
+}
+
 /// A new run records its loss weighting (v by default), a resumed run keeps it unless it is
 /// given again (then it says so), and the weighting changes what is learnt.
 #[test]
