@@ -154,8 +154,8 @@ pub struct Args {
     pub loss_weighting: Option<crate::diffusion::train::Weighting>,
     /// anytop: start each training crop's temporal positions at a random offset from 0 to N,
     /// so the model sees the positions of samples up to N + --crop frames long; without it
-    /// (0) a longer sample's motion fades past the crop length [default: 1000 for a new run or
-    /// a fine-tune; a resumed run keeps its checkpoint's, unless this is given].
+    /// (0) a longer sample's motion fades past the crop length [default: 1000 for a new run; a
+    /// fine-tune or a resumed run keeps its model's, unless this is given].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
     pub position_jitter: Option<u64>,
     /// Save a checkpoint at least this often.

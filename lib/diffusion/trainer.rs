@@ -268,8 +268,8 @@ pub struct AnyTopOptions {
     /// new schedule.
     pub noise_shift: Option<f64>,
     /// The largest random offset of a training crop's temporal positions
-    /// (`data::Crop::position`): none = `DEFAULT_POSITION_JITTER` for a new run or a fine-tune,
-    /// the checkpoint's for a resumed one.
+    /// (`data::Crop::position`): none = `DEFAULT_POSITION_JITTER` for a new run, the model's
+    /// for a fine-tune or a resumed run.
     pub position_jitter: Option<usize>,
 }
 
@@ -426,7 +426,7 @@ impl AnyTopTrainer {
             augment_variants: 0,
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
-            position_jitter: DEFAULT_POSITION_JITTER,
+            position_jitter: base.map_or(DEFAULT_POSITION_JITTER, |b| b.position_jitter),
             weighting: base.map_or(DEFAULT_WEIGHTING, |b| b.weighting),
             init: None,
             skeletons: Vec::new(),

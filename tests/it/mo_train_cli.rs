@@ -265,7 +265,8 @@ fn the_loss_weighting_is_recorded_and_kept_on_resume() {
     assert!(!other.join("checkpoint.json").exists());
 }
 
-/// `--init DIR` starts a new run from that model's weights, size and noise schedule, with the
+/// `--init DIR` starts a new run from that model's weights, size, noise schedule and position
+/// jitter, with the
 /// fine-tune defaults (--lr 1e-3, --batch 4, --crop 20, --augment 0), kept by --resume, and a note of where it started; `--init
 /// builtin` does the same from the model inside the binaries; `--minutes` ends a run on time
 /// with a checkpoint; bad starts are one-line errors that write nothing.
@@ -277,7 +278,7 @@ fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
     let flat = |t: &candle_core::Tensor| t.flatten_all().unwrap().to_vec1::<f32>().unwrap();
     let base = dir.join("base");
     let mut args = train_args(&data, &base, "3");
-    args.extend(["--noise-shift", "4"]);
+    args.extend(["--noise-shift", "4", "--position-jitter", "77"]);
     ok(&run("mo-train", &args, None), "base");
 
     // One step at a vanishing rate, no average: the weights are the base model's.
@@ -294,6 +295,7 @@ fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
     );
     let (b, t) = (info(&base), info(&tuned));
     assert_eq!((&t["config"], t["noise_shift"].as_f64(), t["step"].as_u64()), (&b["config"], Some(4.0), Some(1)));
+    assert_eq!(t["position_jitter"].as_u64(), Some(77), "a fine-tune keeps its model's position jitter");
     assert_eq!(t["init"].as_str(), Some(format!("model {} (step 3)", base.display()).as_str()));
     assert_eq!(t["skeletons"].as_array().map(|a| a.len()), Some(1), "only the new clips' skeleton");
     let (bw, tw) = (load(base.clone()), load(tuned.clone()));
@@ -335,6 +337,7 @@ fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
     let bi = info(&builtin);
     assert!(bi["init"].as_str().is_some_and(|i| i.starts_with("the built-in default model (step ")), "{bi}");
     assert_eq!((bi["config"]["width"].as_u64(), bi["noise_shift"].as_f64()), (Some(64), Some(10.0)));
+    assert_eq!(bi["position_jitter"].as_u64(), Some(0), "the built-in model was trained without jitter");
     let steps = bi["step"].as_u64().unwrap();
     assert!((1..1000).contains(&steps), "a 0.12 s budget ran {steps} steps");
     let sample = run("mo-sample", &[s(&data[1].join("quadruped_walk.bvh")), "--model", s(&builtin), "--frames", "8", "--steps", "3"], None);
