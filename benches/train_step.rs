@@ -127,6 +127,7 @@ fn main() {
         ema: 0.999,
         noise_shift: None,
         position_jitter: None,
+        shift_taper: None,
         weighting: None,
         augment: 0.0,
         augment_variants: 0,

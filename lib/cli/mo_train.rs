@@ -158,6 +158,13 @@ pub struct Args {
     /// fine-tune or a resumed run keeps its model's, unless this is given].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
     pub position_jitter: Option<u64>,
+    /// anytop: taper the noise shift: the schedule's early (nearly clean) steps are shifted
+    /// hardly at all and its last steps in full, so the model also learns to denoise finely;
+    /// under the whole shift the cleanest step keeps noise of a quarter of the signal's scale
+    /// [default: false for a new run; a fine-tune or a resumed run keeps its model's, unless
+    /// this is given: then the model goes on learning under the new schedule].
+    #[arg(long, value_name = "BOOL")]
+    pub shift_taper: Option<bool>,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
@@ -308,6 +315,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         ema: args.ema,
         noise_shift: args.noise_shift,
         position_jitter: args.position_jitter.map(|n| n as usize),
+        shift_taper: args.shift_taper,
         weighting: args.loss_weighting,
     };
     // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.

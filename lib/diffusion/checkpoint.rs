@@ -118,6 +118,10 @@ pub struct CheckpointInfo {
     /// before it existed.
     #[serde(default = "no_shift")]
     pub noise_shift: f64,
+    /// The shift is tapered (`Schedule::cosine_tapered`) rather than whole; false in
+    /// checkpoints written before the taper existed.
+    #[serde(default)]
+    pub shift_taper: bool,
     /// Training crops' temporal positions started at a random offset in `0..=position_jitter`
     /// (`data::Crop::position`); 0 in checkpoints written before it existed (every crop at 0).
     #[serde(default)]
@@ -154,7 +158,11 @@ impl CheckpointInfo {
 
     /// The noise schedule the model was trained with: sampling must use the same one.
     pub fn schedule(&self) -> crate::diffusion::Schedule {
-        crate::diffusion::Schedule::cosine_shifted(self.schedule_steps, self.noise_shift)
+        if self.shift_taper {
+            crate::diffusion::Schedule::cosine_tapered(self.schedule_steps, self.noise_shift)
+        } else {
+            crate::diffusion::Schedule::cosine_shifted(self.schedule_steps, self.noise_shift)
+        }
     }
 }
 

@@ -271,7 +271,14 @@ pub struct AnyTopOptions {
     /// (`data::Crop::position`): none = `DEFAULT_POSITION_JITTER` for a new run, the model's
     /// for a fine-tune or a resumed run.
     pub position_jitter: Option<usize>,
+    /// Whether the noise shift is tapered (`Schedule::cosine_tapered`): none =
+    /// `DEFAULT_SHIFT_TAPER` for a new run, the model's for a fine-tune or a resumed run; given,
+    /// a resumed run continues under the new schedule.
+    pub shift_taper: Option<bool>,
 }
+
+/// Whether a new run tapers its noise shift.
+pub const DEFAULT_SHIFT_TAPER: bool = false;
 
 /// The position jitter of a new run or fine-tune. Without one (0) the model sees positions
 /// 1..=crop only, and a sample longer than the crops loses its motion past them: a 1-skeleton
@@ -427,6 +434,7 @@ impl AnyTopTrainer {
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
             position_jitter: base.map_or(DEFAULT_POSITION_JITTER, |b| b.position_jitter),
+            shift_taper: base.map_or(DEFAULT_SHIFT_TAPER, |b| b.shift_taper),
             weighting: base.map_or(DEFAULT_WEIGHTING, |b| b.weighting),
             init: None,
             skeletons: Vec::new(),
@@ -448,6 +456,9 @@ impl AnyTopTrainer {
         };
         if let Some(shift) = opts.noise_shift {
             info.noise_shift = shift;
+        }
+        if let Some(taper) = opts.shift_taper {
+            info.shift_taper = taper;
         }
         if let Some(jitter) = opts.position_jitter {
             info.position_jitter = jitter;

@@ -184,6 +184,15 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     ok(&changed, "resume with another shift");
     assert!(String::from_utf8_lossy(&changed.stderr).contains("--noise-shift 4"), "no note about the change");
     assert_eq!(info(&out)["noise_shift"].as_f64(), Some(8.0));
+    assert_eq!(info(&out)["shift_taper"].as_bool(), Some(false));
+    // The taper is recorded too, and kept by a resume that does not give it.
+    let mut args = train_args(&data, &out, "5");
+    args.extend(["--resume", "--shift-taper", "true"]);
+    ok(&run("mo-train", &args, None), "resume tapered");
+    let mut args = train_args(&data, &out, "6");
+    args.push("--resume");
+    ok(&run("mo-train", &args, None), "resume again");
+    assert_eq!((info(&out)["noise_shift"].as_f64(), info(&out)["shift_taper"].as_bool()), (Some(8.0), Some(true)));
     // The sampler reads the schedule from the checkpoint.
     let sample = run("mo-sample", &[s(&data[0].join("biped_walk.bvh")), "--model", s(&out), "--frames", "8", "--steps", "3"], None);
     ok(&sample, "sample");
