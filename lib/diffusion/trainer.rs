@@ -277,7 +277,8 @@ pub struct AnyTopOptions {
     pub shift_taper: Option<bool>,
 }
 
-/// Whether a new run tapers its noise shift.
+/// Whether a new run tapers its noise shift: no, the taper made a 1-skeleton proxy's samples
+/// worse (`Schedule::cosine_tapered`).
 pub const DEFAULT_SHIFT_TAPER: bool = false;
 
 /// The position jitter of a new run or fine-tune. Without one (0) the model sees positions
