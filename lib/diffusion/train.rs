@@ -942,6 +942,24 @@ mod tests {
         assert_eq!(sizes(16), vec![4, 4, 4, 4]);
     }
 
+    /// A crop's position offset is what the model sees as its first frame's position: the
+    /// same draw with the crops moved to another offset gives another loss. (Two runs that
+    /// differ in `--position-jitter` differ anyway, through the extra draws in their stream.)
+    #[test]
+    fn a_crops_position_reaches_the_model() {
+        let (set, schedule) = one_quadruped();
+        let mut draw = draw_step(&set, &schedule, &mut SplitMix64::new(3), 2, 12).unwrap();
+        let dev = Device::Cpu;
+        let varmap = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&varmap, 6, &dev), &DenoiserConfig::tiny()).unwrap();
+        let terms = LossTerms { geo: 1.0, vel: 0.0, weighting: Weighting::V };
+        let at_zero = step_gradients(&model, &set, &schedule, &draw, terms, &dev).unwrap().0;
+        assert_eq!(step_gradients(&model, &set, &schedule, &draw, terms, &dev).unwrap().0, at_zero, "the loss of a draw is repeatable");
+        draw.groups.iter_mut().flat_map(|g| g.crops.iter_mut()).for_each(|c| c.position = 300);
+        let moved = step_gradients(&model, &set, &schedule, &draw, terms, &dev).unwrap().0;
+        assert!((moved - at_zero).abs() > 1e-6 * at_zero.abs(), "loss {at_zero} at position 0, {moved} at 300");
+    }
+
     #[test]
     fn splitting_a_skeletons_crops_into_sub_batches_changes_neither_loss_nor_gradient() {
         let (set, schedule) = one_quadruped();

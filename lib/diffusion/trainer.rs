@@ -284,7 +284,7 @@ pub const DEFAULT_SHIFT_TAPER: bool = false;
 /// The position jitter of a new run or fine-tune. Without one (0) the model sees positions
 /// 1..=crop only, and a sample longer than the crops loses its motion past them: a 1-skeleton
 /// proxy (quadruped_v0, tiny, 8,000 steps, crop 40) gave 160-frame samples whose joint speed fell
-/// from 0.29 over frames 0-40 (the walk clip's 0.29) to 0.13 and 0.11 over the next 40s.
+/// from 0.25 over frames 0-40 (the walk clip's 0.29) to 0.13 and 0.11 over the next 40s.
 /// 1,000 covers a 30 fps half minute with the crop. `models/zoo-tiny`, resumed with it at step
 /// 78,121, had its feet alternate more on every zoo skeleton 20,000 steps later (0.53-0.63
 /// against 0.37-0.51) and its quadruped's calibrated coverage rose from 3% to 27%, while its
