@@ -24,11 +24,14 @@ impl AnyTopStart {
             let resume = AnyTopResume::load(out, lr, device)?;
             if resume.differs(opts) {
                 notes.push(
-                    "note: --batch, --crop, --seed or --augment* differ from the checkpoint's; the resumed run is not the one it would have been".to_string(),
+                    "note: --batch, --crop, --seed, --position-jitter or --augment* differ from the checkpoint's; the resumed run is not the one it would have been".to_string(),
                 );
             }
             if let Some((old, new)) = resume.shift_changes(opts) {
                 notes.push(format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
+            }
+            if let Some((old, new)) = resume.taper_changes(opts) {
+                notes.push(format!("note: the checkpoint was trained with --shift-taper {old}; it goes on learning under --shift-taper {new}, which samplers will use too"));
             }
             if let Some((old, new)) = resume.weighting_changes(opts) {
                 notes.push(format!("note: the checkpoint was trained with --loss-weighting {old}; it goes on learning under {new}"));

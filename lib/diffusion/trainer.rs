@@ -385,12 +385,22 @@ impl AnyTopResume {
     /// not the one it would have been).
     pub fn differs(&self, opts: &AnyTopOptions) -> bool {
         let i = &self.loaded.info;
-        i.batch != opts.batch || i.crop != opts.crop || i.seed != opts.seed || i.augment != opts.augment || i.augment_variants != opts.augment_variants
+        i.batch != opts.batch
+            || i.crop != opts.crop
+            || i.seed != opts.seed
+            || i.augment != opts.augment
+            || i.augment_variants != opts.augment_variants
+            || opts.position_jitter.is_some_and(|j| j != i.position_jitter)
     }
 
     /// The loss weighting the checkpoint was trained with, when `opts` asks for another.
     pub fn weighting_changes(&self, opts: &AnyTopOptions) -> Option<(Weighting, Weighting)> {
         opts.weighting.filter(|&w| w != self.loaded.info.weighting).map(|w| (self.loaded.info.weighting, w))
+    }
+
+    /// The checkpoint's shift taper and the one `opts` asks for, when they differ.
+    pub fn taper_changes(&self, opts: &AnyTopOptions) -> Option<(bool, bool)> {
+        opts.shift_taper.filter(|&t| t != self.loaded.info.shift_taper).map(|t| (self.loaded.info.shift_taper, t))
     }
 
     /// The noise shift the checkpoint was trained with, when `opts` asks for another.

@@ -747,12 +747,15 @@ pub fn add_broadcast(x: &Tensor, v: &Tensor, groups: usize) -> Result<Tensor> {
     x.contiguous()?.apply_op2(&v.contiguous()?, op)
 }
 
-/// The parallelism candle's own CPU matmul uses (`Rayon(n)` for n = RAYON_NUM_THREADS or the
-/// CPU count), so our GEMMs split work as candle's do: a fixed number of parts, not the size
-/// of the rayon pool they happen to run in. The result is the same bytes either way.
+/// How many parts our GEMMs split into: `Rayon(n)` for a pool of n > 1 threads (the pool the
+/// call runs in, or the global one), none for one thread. The result is the same bytes either
+/// way; only the time differs. With one thread, `Rayon(n)` made every product a cross-thread
+/// handoff: a caller outside the pool (`mo-train --threads 1` steps on the main thread) injects
+/// each part into the pool, wakes its worker and sleeps until it is done. That wake-up and
+/// sleep took about a third of a training step's CPU (`perf record` of `mo-train --preset tiny
+/// --threads 1`, BENCHMARKS.md).
 fn matmul_parallelism() -> gemm::Parallelism {
-    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    match *THREADS.get_or_init(candle_core::utils::get_num_threads) {
+    match rayon::current_num_threads() {
         n if n > 1 => gemm::Parallelism::Rayon(n),
         _ => gemm::Parallelism::None,
     }

@@ -188,10 +188,15 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     // The taper is recorded too, and kept by a resume that does not give it.
     let mut args = train_args(&data, &out, "5");
     args.extend(["--resume", "--shift-taper", "true"]);
-    ok(&run("mo-train", &args, None), "resume tapered");
+    let tapered = run("mo-train", &args, None);
+    ok(&tapered, "resume tapered");
+    let said = String::from_utf8_lossy(&tapered.stderr);
+    assert!(said.contains("trained with --shift-taper false; it goes on learning under --shift-taper true"), "{said}");
     let mut args = train_args(&data, &out, "6");
     args.push("--resume");
-    ok(&run("mo-train", &args, None), "resume again");
+    let again = run("mo-train", &args, None);
+    ok(&again, "resume again");
+    assert!(!String::from_utf8_lossy(&again.stderr).contains("--shift-taper"), "{}", String::from_utf8_lossy(&again.stderr));
     assert_eq!((info(&out)["noise_shift"].as_f64(), info(&out)["shift_taper"].as_bool()), (Some(8.0), Some(true)));
     // The sampler reads the schedule from the checkpoint.
     let sample = run("mo-sample", &[s(&data[0].join("biped_walk.bvh")), "--model", s(&out), "--frames", "8", "--steps", "3"], None);
@@ -215,11 +220,16 @@ fn the_position_jitter_is_recorded_and_kept_on_resume() {
     assert_eq!(info(&out)["position_jitter"].as_u64(), Some(1000));
     let mut args = train_args(&data, &out, "3");
     args.extend(["--resume", "--position-jitter", "0"]);
-    ok(&run("mo-train", &args, None), "resume without jitter");
+    let changed = run("mo-train", &args, None);
+    ok(&changed, "resume without jitter");
     assert_eq!(info(&out)["position_jitter"].as_u64(), Some(0));
+    // Another jitter draws other data, which the resume says.
+    assert!(String::from_utf8_lossy(&changed.stderr).contains("differ from the checkpoint's"), "{}", String::from_utf8_lossy(&changed.stderr));
     let mut args = train_args(&data, &out, "4");
-    args.push("--resume");
-    ok(&run("mo-train", &args, None), "resume");
+    args.extend(["--resume", "--position-jitter", "0"]);
+    let same = run("mo-train", &args, None);
+    ok(&same, "resume");
+    assert!(!String::from_utf8_lossy(&same.stderr).contains("differ from the checkpoint's"), "{}", String::from_utf8_lossy(&same.stderr));
     assert_eq!(info(&out)["position_jitter"].as_u64(), Some(0));
     // An old checkpoint (no field) resumes without jitter.
     let path = out.join("checkpoint.json");
