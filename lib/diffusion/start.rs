@@ -31,7 +31,9 @@ impl AnyTopStart {
                 notes.push(format!("note: the checkpoint was trained with --noise-shift {old}; it goes on learning under {new}, and samplers will use {new}"));
             }
             if let Some((old, new)) = resume.taper_changes(opts) {
-                notes.push(format!("note: the checkpoint was trained with --shift-taper {old}; it goes on learning under --shift-taper {new}, which samplers will use too"));
+                notes.push(format!(
+                    "note: the checkpoint was trained with --shift-taper {old}; it goes on learning under --shift-taper {new}, which samplers will use too"
+                ));
             }
             if let Some((old, new)) = resume.weighting_changes(opts) {
                 notes.push(format!("note: the checkpoint was trained with --loss-weighting {old}; it goes on learning under {new}"));
