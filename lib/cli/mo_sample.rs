@@ -57,7 +57,10 @@ pub fn sample_frames(seconds: f64, fps: f64) -> anyhow::Result<usize> {
 ///
 /// Normalisation: a skeleton the model was trained on uses its training statistics; else the
 /// document's own statistics (skel-info of a BVH with motion); else the rest-pose row as mean and
-/// the trained skeletons' average spreads (said on stderr).
+/// the trained skeletons' average spreads (said on stderr). A trained skeleton (same names,
+/// parents and proportions) also keeps the rest pose training took from its first clip, so any of
+/// its files or documents gives the same samples (-v says so); another skeleton's rest pose is
+/// the first frame of the file given.
 ///
 /// Sampling: the default, 10 DDIM steps, keeps `mo-sample -n 4` of a 40-joint creature under
 /// 10 s on two slow cores; --steps 100 --sampler ddpm is the reference's full ancestral loop
@@ -189,7 +192,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let skeleton = &arg.skeleton;
     let device = Device::Cpu;
     let loaded = checkpoint::frozen_or_default(args.model.as_deref(), &device)?;
-    let section = arg.record()?;
+    // A skeleton the model was trained on is conditioned and decoded on the record training
+    // built (its rest clip's first frames), whichever of its files or documents is given.
+    let section = match checkpoint::trained_record(&loaded.info.skeletons, skeleton) {
+        Some((file, record)) => {
+            args.common.say("mo-sample").info(format_args!("{}: a trained skeleton: its rest pose is the one training used (frame 0 of {file})", arg.name));
+            record.with_context(|| format!("{}: the rest pose training used (frame 0 of {file})", arg.name))?
+        }
+        None => arg.record()?,
+    };
     super::ood::Known::denoiser(args.model.as_deref(), &loaded.info)?.warn("mo-sample", &arg.name, skeleton, args.common.quiet)?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     let reference = match &args.reference {

@@ -4,13 +4,17 @@
 //! skeleton uses its own). Files are written beside their final names and renamed, so an
 //! interrupted save never leaves a partial file.
 
+use super::data::offsets_agree;
 use super::ema::{Ema, RAW_PREFIX};
 use super::train::{named_vars, AdamW};
+use crate::document::AnyTopSection;
+use crate::motion::Motion;
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
-use crate::repr::anytop::AnyTopStats;
+use crate::repr::anytop::{names_tpose, AnyTopError, AnyTopStats, RestSource, RigOptions};
 use crate::skeleton::Skeleton;
 use candle_core::Device;
 use candle_nn::VarMap;
+use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -70,6 +74,56 @@ pub struct TrainedSkeleton {
     /// checkpoints written before they were recorded.
     #[serde(default)]
     pub offsets: Vec<[f64; 3]>,
+    /// The frames training built its AnyTop record from; absent in checkpoints written before
+    /// they were recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest: Option<TrainedRest>,
+}
+
+/// The frames training built a skeleton's AnyTop record (rig and rest-pose row P_S) from: its
+/// rest clip's first two. The record depends on which clip that is, and the model learnt under
+/// this one; a sampler given the skeleton in any other file builds the same record from these
+/// frames. (zoo-tiny, step 104,440, sampled from `walk_0.bvh`'s own record instead of
+/// `idle_0.bvh`'s, the one training used, moved 0.37-0.86 as much: models/zoo-tiny/MODEL_CARD.md.)
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TrainedRest {
+    /// The clip's file name, for messages.
+    pub file: String,
+    /// The frames are a T-pose file's (`RestSource::TPose`), not a clip's first frame.
+    pub tpose: bool,
+    pub frame_time: f64,
+    /// Local rotations (x, y, z, w) and translations of every joint, frame 0's then frame 1's.
+    pub rotations: Vec<[f64; 4]>,
+    pub translations: Vec<[f64; 3]>,
+}
+
+impl TrainedRest {
+    /// The record of `motion`'s first two frames, from the clip named `clip`.
+    pub fn new(clip: &str, motion: &Motion) -> TrainedRest {
+        let first = motion.first_frames(2);
+        TrainedRest {
+            file: Path::new(clip).file_name().map_or_else(|| clip.to_string(), |f| f.to_string_lossy().into_owned()),
+            tpose: names_tpose(clip),
+            frame_time: first.frame_time,
+            rotations: first.rotations.iter().map(|q| q.to_array()).collect(),
+            translations: first.translations.iter().map(|t| t.to_array()).collect(),
+        }
+    }
+
+    /// The frames as a motion of `joints` joints (None when they do not fit).
+    fn motion(&self, joints: usize) -> Option<Motion> {
+        let n = self.rotations.len();
+        if joints == 0 || n != self.translations.len() || !n.is_multiple_of(joints) || !(1..=2).contains(&(n / joints)) {
+            return None;
+        }
+        Some(Motion {
+            frames: n / joints,
+            joints,
+            frame_time: self.frame_time,
+            rotations: self.rotations.iter().map(|&q| DQuat::from_array(q)).collect(),
+            translations: self.translations.iter().map(|&t| DVec3::from_array(t)).collect(),
+        })
+    }
 }
 
 impl TrainedSkeleton {
@@ -83,6 +137,22 @@ impl TrainedSkeleton {
     fn offset_gap(&self, s: &Skeleton) -> f64 {
         s.joints.iter().zip(&self.offsets).skip(1).map(|(j, o)| (j.offset - glam::DVec3::from_array(*o)).abs().max_element()).fold(0.0, f64::max)
     }
+}
+
+/// The AnyTop record training built for `s` (as `diffusion::data` builds it), when `s` is a
+/// trained skeleton with the same proportions and the checkpoint recorded its rest frames;
+/// with the file those frames came from.
+pub fn trained_record(trained: &[TrainedSkeleton], s: &Skeleton) -> Option<(String, Result<AnyTopSection, AnyTopError>)> {
+    let t = find_trained(trained, s)?;
+    let rest = t.rest.as_ref()?;
+    let offsets = t.offsets.iter().map(|&o| DVec3::from_array(o));
+    if t.offsets.len() != s.len() || !offsets_agree(s.rest_extent(), s.joints.iter().map(|j| j.offset), offsets) {
+        return None;
+    }
+    let motion = rest.motion(s.len())?;
+    let file = rest.file.clone();
+    let rest_source = if rest.tpose { RestSource::TPose { file: file.clone() } } else { RestSource::FirstClip { file: file.clone() } };
+    Some((file, AnyTopSection::new(s, &motion, &RigOptions { rest_source, ..RigOptions::default() })))
 }
 
 /// The trained skeleton whose statistics suit `s`: among those with its joint names and
@@ -350,6 +420,38 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_trained_record_is_rebuilt_exactly_for_the_same_proportions_only() {
+        let (skeleton, motion) = crate::synth::creature("quadruped", 0).unwrap();
+        let later = motion.frame_range(10, motion.frames);
+        let built = |m: &Motion| {
+            let options = RigOptions { rest_source: RestSource::FirstClip { file: "idle.bvh".into() }, ..RigOptions::default() };
+            AnyTopSection::new(&skeleton, &m.first_frames(2), &options).unwrap()
+        };
+        let trained = TrainedSkeleton {
+            name: "q".into(),
+            joints: skeleton.joints.iter().map(|j| j.name.clone()).collect(),
+            parents: skeleton.parents(),
+            stats: AnyTopStats { mean: vec![0.0; skeleton.len() * 13], std: vec![1.0; skeleton.len() * 13] },
+            clips: 1,
+            offsets: skeleton.joints.iter().map(|j| j.offset.to_array()).collect(),
+            rest: Some(TrainedRest::new("zoo/q/idle.bvh", &motion)),
+        };
+        // Through JSON, as a checkpoint keeps it.
+        let list: Vec<TrainedSkeleton> = serde_json::from_str(&serde_json::to_string(&[trained.clone()]).unwrap()).unwrap();
+        let (file, record) = trained_record(&list, &skeleton).unwrap();
+        let record = record.unwrap();
+        assert_eq!(file, "idle.bvh");
+        assert_eq!(record.rest_row, built(&motion).rest_row);
+        assert_ne!(record.rest_row, built(&later).rest_row, "the frames chosen make no difference here");
+        assert_eq!(serde_json::to_string(&record.rig).unwrap(), serde_json::to_string(&built(&motion).rig).unwrap());
+        // Other proportions, or no recorded frames: no trained record.
+        let mut longer = skeleton.clone();
+        longer.joints.iter_mut().for_each(|j| j.offset *= 1.1);
+        assert!(trained_record(&list, &longer).is_none());
+        assert!(trained_record(&[TrainedSkeleton { rest: None, ..trained }], &skeleton).is_none());
+    }
+
+    #[test]
     fn find_trained_prefers_the_nearest_proportions() {
         let (skeleton, _) = crate::synth::creature("quadruped", 0).unwrap();
         let trained = |name: &str, scale: f64| TrainedSkeleton {
@@ -359,6 +461,7 @@ mod tests {
             stats: AnyTopStats { mean: vec![0.0; skeleton.len() * 13], std: vec![1.0; skeleton.len() * 13] },
             clips: 1,
             offsets: skeleton.joints.iter().map(|j| (j.offset * scale).to_array()).collect(),
+            rest: None,
         };
         let list = [trained("long", 1.3), trained("plain", 1.0), trained("short", 0.8)];
         assert_eq!(find_trained(&list, &skeleton).map(|t| t.name.as_str()), Some("plain"));

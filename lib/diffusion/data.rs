@@ -51,6 +51,9 @@ pub struct SkeletonData {
     pub stats: AnyTopStats,
     /// P_S, normalised: `[joints * 13]`.
     pub rest_row: Vec<f32>,
+    /// The frames `section` (rig and P_S) was built from: the rest clip's first two, and that
+    /// clip's name.
+    pub rest: (String, Motion),
     pub relations: Vec<Vec<u8>>,
     pub distances: Vec<Vec<u8>>,
     /// One embedding per joint.
@@ -224,6 +227,7 @@ fn prepare<'a>(
         distances: topology::distances(&skeleton, dmax),
         names: names.embed_skeleton(&skeleton),
         rest_row: rest.data,
+        rest: (rest_name.to_string(), rest_motion.first_frames(2)),
         name,
         skeleton,
         section,

@@ -6,7 +6,7 @@
 //! A run that is stopped and resumed is bit-identical to one that was not: the data stream of
 //! step k depends only on the seed and k (`step_rng`), and a checkpoint carries the optimiser.
 
-use super::checkpoint::{self, CheckpointInfo, TrainedSkeleton};
+use super::checkpoint::{self, CheckpointInfo, TrainedRest, TrainedSkeleton};
 use super::data::TrainSet;
 use super::ema::Ema;
 use super::train::{named_vars, train_step, AdamW, LossTerms, Weighting};
@@ -499,6 +499,7 @@ impl AnyTopTrainer {
                 stats: s.stats.clone(),
                 clips: s.clips.len(),
                 offsets: s.skeleton.joints.iter().map(|j| j.offset.to_array()).collect(),
+                rest: Some(TrainedRest::new(&s.rest.0, &s.rest.1)),
             })
             .collect();
         let vars = named_vars(&varmap);

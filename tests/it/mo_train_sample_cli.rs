@@ -69,3 +69,53 @@ fn resume_equals_the_straight_run_and_samples_are_deterministic() {
     assert_eq!(a.stdout, b.stdout, "the built-in model is deterministic");
     assert_ne!(a.stdout, c.stdout, "another seed, other samples");
 }
+
+/// `text`, a BVH file, without its first `drop` frames.
+fn without_first_frames(text: &str, drop: usize) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| l.starts_with("Frame Time:")).unwrap();
+    let frames: usize = lines[at - 1].trim_start_matches("Frames:").trim().parse().unwrap();
+    let mut out: Vec<String> = lines[..at - 1].iter().map(|l| l.to_string()).collect();
+    out.push(format!("Frames: {}", frames - drop));
+    out.push(lines[at].to_string());
+    out.extend(lines[at + 1 + drop..].iter().map(|l| l.to_string()));
+    out.join("\n") + "\n"
+}
+
+/// A trained skeleton samples the same from any of its clips: the rest pose (rig and P_S) is
+/// the one training built, from its rest clip's first frames, not the given file's. A
+/// checkpoint without the recorded rest (written before it existed) falls back to the file's.
+#[test]
+fn a_trained_skeleton_samples_on_its_trained_rest_pose_from_any_clip() {
+    let dir = tempdir("trained-rest");
+    let data = dir.join("data");
+    std::fs::create_dir_all(&data).unwrap();
+    let text = std::fs::read_to_string(example("quadruped.bvh")).unwrap();
+    let (first, later) = (data.join("a_walk.bvh"), data.join("b_later.bvh"));
+    std::fs::write(&first, &text).unwrap();
+    std::fs::write(&later, without_first_frames(&text, 20)).unwrap();
+    let model = dir.join("model");
+    ok(&run("mo-train", &[s(&data), "--out", s(&model), "--preset", "tiny", "--steps", "2", "--batch", "2", "--crop", "12", "-q"], None), "train");
+    let read = |p: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
+    let info = read(&model.join("checkpoint.json"));
+    let rest = &info["skeletons"][0]["rest"];
+    assert_eq!(rest["file"].as_str(), Some("a_walk.bvh"), "{rest}");
+    let sample = |clip: &Path, tag: &str| {
+        let bvh = dir.join(format!("{tag}.bvh"));
+        let out = run("mo-sample", &[s(clip), "--model", s(&model), "--frames", "12", "--steps", "3", "--seed", "5", "--bvh", s(&bvh), "-v"], None);
+        ok(&out, tag);
+        (std::fs::read(&bvh).unwrap(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (from_first, _) = sample(&first, "first");
+    let (from_later, said) = sample(&later, "later");
+    assert!(said.contains("its rest pose is the one training used (frame 0 of a_walk.bvh)"), "{said}");
+    assert_eq!(from_first, from_later, "the clip given changed the sample");
+    // Without the recorded rest, the later clip's own first frame makes another sample.
+    let path = model.join("checkpoint.json");
+    let mut old = read(&path);
+    old["skeletons"][0].as_object_mut().unwrap().remove("rest");
+    std::fs::write(&path, serde_json::to_string(&old).unwrap()).unwrap();
+    let (old_later, said) = sample(&later, "old-later");
+    assert!(!said.contains("training used"), "{said}");
+    assert_ne!(old_later, from_later);
+}
