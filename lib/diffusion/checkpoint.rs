@@ -84,7 +84,7 @@ pub struct TrainedSkeleton {
 /// rest clip's first two. The record depends on which clip that is, and the model learnt under
 /// this one; a sampler given the skeleton in any other file builds the same record from these
 /// frames. (zoo-tiny, step 104,440, sampled from `walk_0.bvh`'s own record instead of
-/// `idle_0.bvh`'s, the one training used, moved 0.37-0.86 as much: models/zoo-tiny/MODEL_CARD.md.)
+/// `idle_0.bvh`'s, the one training used, moved 0.53-0.86 times as much: models/zoo-tiny/MODEL_CARD.md.)
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TrainedRest {
     /// The clip's file name, for messages.
