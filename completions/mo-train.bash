@@ -34,7 +34,7 @@ _mo__train() {
                     return 0
                     ;;
                 --preset)
-                    COMPREPLY=($(compgen -W "tiny small paper" -- "${cur}"))
+                    COMPREPLY=($(compgen -W "tiny compact small paper" -- "${cur}"))
                     return 0
                     ;;
                 --steps)

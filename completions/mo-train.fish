@@ -1,5 +1,6 @@
 complete -c mo-train -l out -d 'Model directory to write (and to resume from)' -r -F
-complete -c mo-train -l preset -d 'Model size: tiny, small or paper (width 128, 4 layers, 4 heads)' -r -f -a "tiny\t''
+complete -c mo-train -l preset -d 'Model size: tiny (width 32, 2 layers), compact (width 64, 2 layers; for sata the same as small), small (width 64, 4 layers) or paper (width 128, 4 layers, 4 heads)' -r -f -a "tiny\t''
+compact\t''
 small\t''
 paper\t''"
 complete -c mo-train -l steps -d 'Training steps in total (a resumed run counts the steps already done) [default: 10000, or no limit with --minutes]' -r

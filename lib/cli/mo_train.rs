@@ -73,7 +73,8 @@ pub struct Args {
     /// Model directory to write (and to resume from).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Model size: tiny, small or paper (width 128, 4 layers, 4 heads).
+    /// Model size: tiny (width 32, 2 layers), compact (width 64, 2 layers; for sata the same as
+    /// small), small (width 64, 4 layers) or paper (width 128, 4 layers, 4 heads).
     #[arg(long, value_enum, default_value_t = Preset::Small)]
     pub preset: Preset,
     /// Training steps in total (a resumed run counts the steps already done) [default: 10000,

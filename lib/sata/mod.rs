@@ -108,7 +108,8 @@ impl SataConfig {
     pub fn preset(preset: crate::nn::Preset) -> SataConfig {
         match preset {
             crate::nn::Preset::Tiny => SataConfig::tiny(),
-            crate::nn::Preset::Small => SataConfig::small(),
+            // The latent model's small is already this size (width 64, 2 blocks).
+            crate::nn::Preset::Compact | crate::nn::Preset::Small => SataConfig::small(),
             crate::nn::Preset::Paper => SataConfig::paper(),
         }
     }

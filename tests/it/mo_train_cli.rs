@@ -373,3 +373,19 @@ fn fine_tuning_starts_from_a_model_and_keeps_its_size_and_schedule() {
     common::check_failure("mo-train", "init over a checkpoint", &run("mo-train", &args, None), "already holds a checkpoint");
     assert!(!none.exists());
 }
+
+/// Each denoiser preset trains the size it names, recorded in the checkpoint.
+#[test]
+fn presets_train_the_sizes_they_name() {
+    let dir = tempdir("train-presets");
+    let data = data(&dir);
+    for (preset, width, layers) in [("tiny", 32, 2), ("compact", 64, 2)] {
+        let out = dir.join(preset);
+        let mut args = train_args(&data, &out, "1");
+        let at = args.iter().position(|a| *a == "tiny").unwrap();
+        args[at] = preset;
+        ok(&run("mo-train", &args, None), preset);
+        let config = &info(&out)["config"];
+        assert_eq!((config["width"].as_u64(), config["layers"].as_u64()), (Some(width), Some(layers)), "{preset}: {config}");
+    }
+}
