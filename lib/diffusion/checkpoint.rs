@@ -4,13 +4,13 @@
 //! skeleton uses its own). Files are written beside their final names and renamed, so an
 //! interrupted save never leaves a partial file.
 
-use super::data::offsets_agree;
+use super::data::{offsets_agree, rest_record};
 use super::ema::{Ema, RAW_PREFIX};
 use super::train::{named_vars, AdamW};
 use crate::document::AnyTopSection;
 use crate::motion::Motion;
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
-use crate::repr::anytop::{names_tpose, AnyTopError, AnyTopStats, RestSource, RigOptions};
+use crate::repr::anytop::{AnyTopError, AnyTopStats};
 use crate::skeleton::Skeleton;
 use candle_core::Device;
 use candle_nn::VarMap;
@@ -87,10 +87,8 @@ pub struct TrainedSkeleton {
 /// `idle_0.bvh`'s, the one training used, moved 0.53-0.86 times as much: models/zoo-tiny/MODEL_CARD.md.)
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TrainedRest {
-    /// The clip's file name, for messages.
+    /// The clip's file name (it also says whether the frames are a T-pose file's).
     pub file: String,
-    /// The frames are a T-pose file's (`RestSource::TPose`), not a clip's first frame.
-    pub tpose: bool,
     pub frame_time: f64,
     /// Local rotations (x, y, z, w) and translations of every joint, frame 0's then frame 1's.
     pub rotations: Vec<[f64; 4]>,
@@ -103,7 +101,6 @@ impl TrainedRest {
         let first = motion.first_frames(2);
         TrainedRest {
             file: Path::new(clip).file_name().map_or_else(|| clip.to_string(), |f| f.to_string_lossy().into_owned()),
-            tpose: names_tpose(clip),
             frame_time: first.frame_time,
             rotations: first.rotations.iter().map(|q| q.to_array()).collect(),
             translations: first.translations.iter().map(|t| t.to_array()).collect(),
@@ -150,9 +147,7 @@ pub fn trained_record(trained: &[TrainedSkeleton], s: &Skeleton) -> Option<(Stri
         return None;
     }
     let motion = rest.motion(s.len())?;
-    let file = rest.file.clone();
-    let rest_source = if rest.tpose { RestSource::TPose { file: file.clone() } } else { RestSource::FirstClip { file: file.clone() } };
-    Some((file, AnyTopSection::new(s, &motion, &RigOptions { rest_source, ..RigOptions::default() })))
+    Some((rest.file.clone(), rest_record(s, &rest.file, &motion)))
 }
 
 /// The trained skeleton whose statistics suit `s`: among those with its joint names and
@@ -418,6 +413,7 @@ pub fn load_optimizer(dir: &Path, step: u64, device: &Device, lr: f64) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::repr::anytop::{RestSource, RigOptions};
 
     #[test]
     fn the_trained_record_is_rebuilt_exactly_for_the_same_proportions_only() {

@@ -183,6 +183,15 @@ fn group_names(groups: &[Vec<Clip>]) -> Vec<String> {
     names
 }
 
+/// The AnyTop record (rig and P_S) of a skeleton whose rest pose is the first frames of the clip
+/// `file` (a T-pose file by AnyTop's name rule); training builds it so, and sampling rebuilds a
+/// trained skeleton's from the frames its checkpoint keeps (`checkpoint::trained_record`).
+pub fn rest_record(skeleton: &Skeleton, file: &str, rest: &Motion) -> Result<AnyTopSection, anytop::AnyTopError> {
+    let file = file.to_string();
+    let rest_source = if anytop::names_tpose(&file) { RestSource::TPose { file } } else { RestSource::FirstClip { file } };
+    AnyTopSection::new(skeleton, &rest.first_frames(2), &RigOptions { rest_source, ..RigOptions::default() })
+}
+
 /// Prepare one skeleton from its clips: rig and P_S from `rest` (file name, motion), features
 /// of every clip long enough (the others go to `dropped`), statistics, topology and names.
 /// `None` when no clip is long enough.
@@ -196,11 +205,7 @@ fn prepare<'a>(
     dropped: &mut Vec<String>,
 ) -> Result<Option<SkeletonData>, DataError> {
     let (rest_name, rest_motion) = rest;
-    let source =
-        if anytop::names_tpose(rest_name) { RestSource::TPose { file: rest_name.to_string() } } else { RestSource::FirstClip { file: rest_name.to_string() } };
-    let options = RigOptions { rest_source: source, ..RigOptions::default() };
-    let section = AnyTopSection::new(&skeleton, &rest_motion.first_frames(2), &options)
-        .map_err(|e| DataError::Clip { clip: rest_name.to_string(), why: e.to_string() })?;
+    let section = rest_record(&skeleton, rest_name, rest_motion).map_err(|e| DataError::Clip { clip: rest_name.to_string(), why: e.to_string() })?;
     let mut features = Vec::new();
     let mut clip_names = Vec::new();
     for (clip, motion) in clips {
