@@ -42,7 +42,7 @@ fn main() {
     let encoded = section.rig.encode(skeleton, arg.motion.as_ref().unwrap()).expect("encode");
     let reference = encoded.features;
     let (frames, j) = (reference.frames, reference.joints);
-    let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, None).expect("condition");
+    let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row).expect("condition");
     let stats = &condition.stats;
     let cond = condition.condition();
     let schedule = loaded.info.schedule();

@@ -99,11 +99,15 @@ def sample(bindir, model, folder, skeleton, out, n, frames, steps, sampler, seed
     # A model spec is a directory, 'builtin' or 'examples', and optionally more mo-sample
     # options after it; its own --steps / --sampler win over the table-wide ones.
     where, *extra = model.split()
+    # '--document' (ours, not mo-sample's): give the skeleton as `skel-info SKELETON | mo-sample`,
+    # the README's pipe, whose document carries statistics measured on the clip.
+    document = "--document" in extra
+    extra = [e for e in extra if e != "--document"]
     common = ["-n", str(n), "--frames", str(frames), "--seed", str(seed), "-q", "--bvh", os.path.join(out, "sample_{i}.bvh")]
     if where == "examples":
         cmd = [f"{bindir}/mo-sample", "--examples", folder] + common
     else:
-        cmd = [f"{bindir}/mo-sample", skeleton] + common
+        cmd = [f"{bindir}/mo-sample"] + ([] if document else [skeleton]) + common
         if "--steps" not in extra:
             cmd += ["--steps", str(steps)]
         if "--sampler" not in extra:
@@ -112,7 +116,13 @@ def sample(bindir, model, folder, skeleton, out, n, frames, steps, sampler, seed
             cmd += ["--model", where]
     cmd += extra
     t = time.monotonic()
-    run(cmd)
+    if document:
+        doc = run([f"{bindir}/skel-info", skeleton])
+        res = subprocess.run(cmd, input=doc, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        if res.returncode != 0:
+            sys.exit(f"{' '.join(cmd)} < skel-info {skeleton} failed: {res.stderr.decode().strip()}")
+    else:
+        run(cmd)
     return time.monotonic() - t
 
 
@@ -123,7 +133,7 @@ def row(cells):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default="target/release")
-    ap.add_argument("--model", action="append", default=[], metavar="NAME=DIR", help="'builtin' as DIR = the embedded model, 'examples' = mo-sample --examples FOLDER (no model); mo-sample options may follow DIR, e.g. 'raw=builtin --smooth 0'")
+    ap.add_argument("--model", action="append", default=[], metavar="NAME=DIR", help="'builtin' as DIR = the embedded model, 'examples' = mo-sample --examples FOLDER (no model); mo-sample options may follow DIR, e.g. 'raw=builtin --smooth 0'; '--document' samples from `skel-info SKELETON | mo-sample` instead of the file")
     ap.add_argument("--skeletons", nargs="+", required=True, metavar="FOLDER")
     ap.add_argument("-n", type=int, default=8)
     ap.add_argument("--frames", type=int, default=120)

@@ -55,9 +55,10 @@ pub fn sample_frames(seconds: f64, fps: f64) -> anyhow::Result<usize> {
 /// stdout (or -o), or BVH files with --bvh PATTERN ('{i}' = sample index), posed by inverse
 /// kinematics from the generated joint positions.
 ///
-/// Normalisation: a skeleton the model was trained on uses its training statistics; else the
-/// document's own statistics (skel-info of a BVH with motion); else the rest-pose row as mean and
-/// the trained skeletons' average spreads (said on stderr). A trained skeleton (same names,
+/// Normalisation: a skeleton the model was trained on uses its training statistics; any other
+/// takes its rest-pose row as the mean and the trained skeletons' average spreads (-v says so),
+/// also when its document carries statistics, so a file and its skel-info document give the
+/// same samples (fine-tune on its clips to give a model its own). A trained skeleton (same names,
 /// parents and proportions) also keeps the rest pose training took from its first clip, so any of
 /// its files or documents gives the same samples (-v says so); another skeleton's rest pose is
 /// the first frame of the file given.
@@ -119,8 +120,8 @@ pub struct Args {
     /// The same as SKELETON, as a named option.
     #[arg(long = "skeleton", value_name = "PATH", conflicts_with = "skeleton")]
     pub skeleton_option: Option<PathBuf>,
-    /// Model directory written by mo-train [default: the built-in model, a small denoiser
-    /// trained on the synthetic zoo; see models/zoo-small/MODEL_CARD.md].
+    /// Model directory written by mo-train [default: the built-in model, a compact denoiser
+    /// trained on the synthetic zoo; see models/zoo-compact/MODEL_CARD.md].
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
     /// Number of samples.
@@ -226,9 +227,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     crate::budget::check(&format!("{count} samples of {frames} frames on {} joints", skeleton.len()), tokens, loaded.info.config.width * 4 * 4)?;
     let mask = reference.as_ref().map(|r| r.mask(args.keep_frames.as_deref(), args.keep_joints.as_deref(), skeleton, frames)).transpose()?;
 
-    let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row, section.stats.as_ref()).with_context(|| arg.name.clone())?;
-    if condition.stats_source == StatsSource::Fallback && !args.common.quiet {
-        eprintln!("mo-sample: {}: not a trained skeleton and no statistics in it: normalising by its rest pose and the trained skeletons' spreads", arg.name);
+    // A skeleton the model never saw is normalised by its rest pose and the trained skeletons'
+    // spreads even when its document carries statistics of its own motion: with those, the
+    // built-in model's poses were 2-17x farther from the clip's on six real skeletons
+    // (models/zoo-compact/MODEL_CARD.md, "The pipe and the file"), and the file and the pipe
+    // now sample alike.
+    let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row).with_context(|| arg.name.clone())?;
+    if condition.stats_source == StatsSource::Fallback {
+        args.common
+            .say("mo-sample")
+            .info(format_args!("{}: not a trained skeleton: normalising by its rest pose and the trained skeletons' spreads", arg.name));
     }
     let cond = condition.condition();
     let post = PostProcess::new(args.smooth, args.blend, !args.no_plant_feet, fps, crate::cli::bounds::MAX_SECONDS)?;

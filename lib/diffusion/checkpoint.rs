@@ -368,8 +368,8 @@ pub fn frozen(dir: &Path, device: &Device) -> Result<FrozenDenoiser, CheckpointE
     frozen_bytes(&info, &weights, device).map_err(CheckpointError::of(format!("model {}", dir.display())))
 }
 
-/// The default model that ships inside the binaries: a `small` denoiser trained on the
-/// synthetic zoo (models/zoo-small, see its MODEL_CARD.md).
+/// The default model that ships inside the binaries: a `compact` denoiser trained on the
+/// synthetic zoo (models/zoo-compact, see its MODEL_CARD.md).
 pub fn frozen_default(device: &Device) -> Result<FrozenDenoiser, CheckpointError> {
     frozen_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))
 }
@@ -383,8 +383,8 @@ pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<FrozenDe
 }
 
 /// The built-in model's `checkpoint.json` and `model.safetensors`, embedded in the binaries.
-pub const BUILTIN_INFO: &[u8] = include_bytes!("../../models/zoo-small/checkpoint.json");
-pub const BUILTIN_WEIGHTS: &[u8] = include_bytes!("../../models/zoo-small/model.safetensors");
+pub const BUILTIN_INFO: &[u8] = include_bytes!("../../models/zoo-compact/checkpoint.json");
+pub const BUILTIN_WEIGHTS: &[u8] = include_bytes!("../../models/zoo-compact/model.safetensors");
 /// How messages name the built-in model.
 pub const BUILTIN_NAME: &str = "the built-in default model";
 

@@ -1,9 +1,9 @@
 //! What a trained denoiser needs to know about a skeleton, built once per skeleton for
 //! sampling, editing and DIFT features alike: its normalised rest-pose row P_S, relations R,
 //! distances D, joint-name embeddings, and the normalisation statistics — chosen in this order:
-//! the statistics the model was trained with for that skeleton, else statistics measured on
-//! the caller's motion, else a fallback built from the rest pose and the trained skeletons'
-//! spreads (a skeleton nobody measured).
+//! the statistics the model was trained with for that skeleton, else (sampling) a fallback built
+//! from the rest pose and the trained skeletons' spreads, or (DIFT, which compares two motions)
+//! statistics measured on the caller's motion.
 
 use super::checkpoint::{find_trained, CheckpointInfo};
 use super::sample::Condition;
@@ -35,14 +35,14 @@ pub struct SkeletonCondition {
 }
 
 impl SkeletonCondition {
-    /// The condition for `skeleton` under the model `info` describes. `rest_row` is the
-    /// skeleton's P_S in physical units (J rows of 13); `measured` are statistics of the
-    /// caller's own motion, used when the model was not trained on this skeleton.
-    pub fn new(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>], measured: Option<&AnyTopStats>) -> Result<SkeletonCondition, DiffusionError> {
-        let (stats, stats_source) = match (find_trained(&info.skeletons, skeleton), measured) {
-            (Some(t), _) => (t.stats.clone(), StatsSource::Trained),
-            (None, Some(s)) => (s.clone(), StatsSource::Measured),
-            (None, None) => (fallback_stats(rest_row, &info.skeletons.iter().map(|t| &t.stats).collect::<Vec<_>>())?, StatsSource::Fallback),
+    /// The condition for `skeleton` under the model `info` describes, for sampling. `rest_row`
+    /// is the skeleton's P_S in physical units (J rows of 13). A skeleton the model was not
+    /// trained on gets the fallback, never statistics of a caller's motion: with those the
+    /// built-in model's samples left the clips' poses (models/zoo-compact/MODEL_CARD.md).
+    pub fn new(info: &CheckpointInfo, skeleton: &Skeleton, rest_row: &[Vec<f32>]) -> Result<SkeletonCondition, DiffusionError> {
+        let (stats, stats_source) = match find_trained(&info.skeletons, skeleton) {
+            Some(t) => (t.stats.clone(), StatsSource::Trained),
+            None => (fallback_stats(rest_row, &info.skeletons.iter().map(|t| &t.stats).collect::<Vec<_>>())?, StatsSource::Fallback),
         };
         SkeletonCondition::with_stats(info, skeleton, rest_row, stats, stats_source)
     }

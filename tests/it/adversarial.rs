@@ -243,7 +243,7 @@ fn invalid_inputs_are_refused() {
     // A model whose schedule has no steps.
     let model = dir.join("model");
     std::fs::create_dir_all(&model).unwrap();
-    let zoo = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/zoo-small");
+    let zoo = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/zoo-compact");
     std::fs::copy(zoo.join("model.safetensors"), model.join("model.safetensors")).unwrap();
     let mut info: serde_json::Value = serde_json::from_slice(&std::fs::read(zoo.join("checkpoint.json")).unwrap()).unwrap();
     info["schedule_steps"] = serde_json::json!(0);

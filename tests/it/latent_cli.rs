@@ -67,7 +67,7 @@ fn bad_latent_inputs_fail_cleanly() {
     std::fs::write(&narrow, npy::to_bytes(&[10, 7], &[0.0; 70]).unwrap()).unwrap();
     let r = run("mo-encode", &["--decode-latent", "--skeleton", s(&dragon), s(&narrow)], None);
     check_failure("mo-encode", "wrong latent width", &r, "latents have 7 values per frame");
-    let denoiser = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/zoo-small");
+    let denoiser = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/zoo-compact");
     let r = run("mo-encode", &["--latent", "--model", s(&denoiser), s(&quad)], None);
     check_failure("mo-encode", "a diffusion model as the latent model", &r, "expected 'menagerie.sata'");
     let r = run("mo-retarget", &["--method", "latent", s(&quad), "--to", s(&dragon), "--bind", "auto"], None);

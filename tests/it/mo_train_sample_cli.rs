@@ -119,3 +119,32 @@ fn a_trained_skeleton_samples_on_its_trained_rest_pose_from_any_clip() {
     assert!(!said.contains("training used"), "{said}");
     assert_ne!(old_later, from_later);
 }
+
+#[test]
+fn an_untrained_skeleton_samples_alike_from_its_file_and_its_document() {
+    // The document carries statistics of the clip's motion; sampling ignores them for a
+    // skeleton the model never saw, so `skel-info FILE | mo-sample` is `mo-sample FILE`.
+    let dir = tempdir("file-document");
+    let model = dir.join("model");
+    ok(
+        &run("mo-train", &[s(&example("quadruped.bvh")), "--out", s(&model), "--preset", "tiny", "--steps", "2", "--batch", "2", "--crop", "12", "-q"], None),
+        "train",
+    );
+    let dragon = example("dragon.bvh");
+    let info = run("skel-info", &[s(&dragon)], None);
+    ok(&info, "skel-info");
+    let document: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert!(document["anytop"]["stats"].is_object(), "the document carries statistics");
+    let doc_path = dir.join("dragon.json");
+    std::fs::write(&doc_path, &info.stdout).unwrap();
+    let sample = |skeleton: &Path, tag: &str| {
+        let npy = dir.join(format!("{tag}.npy"));
+        let out = run("mo-sample", &[s(skeleton), "--model", s(&model), "--frames", "12", "--steps", "3", "--seed", "5", "-o", s(&npy), "-v"], None);
+        ok(&out, tag);
+        (std::fs::read(&npy).unwrap(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (from_file, said) = sample(&dragon, "file");
+    assert!(said.contains("not a trained skeleton: normalising by its rest pose"), "{said}");
+    let (from_document, _) = sample(&doc_path, "document");
+    assert_eq!(from_file, from_document, "the document's statistics changed the samples");
+}
