@@ -229,7 +229,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     // A skeleton the model never saw is normalised by its rest pose and the trained skeletons'
     // spreads even when its document carries statistics of its own motion: with those, the
-    // built-in model's poses were 2-17x farther from the clip's on six real skeletons
+    // built-in model's poses were 2-12x farther from the clip's on six real skeletons
     // (models/zoo-compact/MODEL_CARD.md, "The pipe and the file"), and the file and the pipe
     // now sample alike.
     let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row).with_context(|| arg.name.clone())?;

@@ -56,10 +56,11 @@ EXAMPLES:
 /// Fine-tuning (--init builtin or --init DIR): the run starts from that model's weights,
 /// size and noise schedule instead of random weights, with a fresh optimiser and the new
 /// clips' own statistics; it defaults to --lr 1e-3, --batch 4, --crop 20 and --augment 0
-/// (every draw is of your skeletons): many small steps, because five minutes on one clip
-/// buy a few hundred (models/zoo-small/MODEL_CARD.md, "Fine-tuning"). With --minutes it
-/// trains for a wall-time budget rather than a step count. The result is an ordinary model
-/// directory for mo-sample, mo-dift and mo-segment --model.
+/// (every draw is of your skeletons): many small steps (five minutes on one clip buy
+/// 1,900-9,800 of the built-in model's on two quiet cores, fewer the more joints;
+/// models/zoo-compact/MODEL_CARD.md, "Fine-tuning"). With --minutes it trains for a wall-time
+/// budget rather than a step count. The result is an ordinary model directory for mo-sample,
+/// mo-dift and mo-segment --model.
 ///
 /// --resume continues with the checkpoint's --lr, --batch, --crop and --augment unless they
 /// are given, so a fine-tune resumes as a fine-tune; given ones are recorded in the
@@ -230,6 +231,8 @@ fn catch_interrupts() -> anyhow::Result<()> {
 /// of a skeleton the built-in model never saw, a thousand steps brought a chicken's poses to
 /// within 0.012 of its clip's, where 268 steps of batch 16 left them at 0.015; crops of 20
 /// frames cost half of 40's per step and did as well per step (models/zoo-small/MODEL_CARD.md).
+/// From the compact built-in, lr 3e-4 left the monkey's poses farther off than 1e-3 in the same
+/// steps (models/zoo-compact/MODEL_CARD.md).
 pub const INIT_LR: f64 = 1e-3;
 pub const INIT_BATCH: u64 = 4;
 pub const INIT_CROP: u64 = 20;
