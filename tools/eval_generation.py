@@ -44,8 +44,8 @@ PHYSICS = [
 ]
 
 
-def run(cmd, stdout=None):
-    res = subprocess.run(cmd, stdout=stdout or subprocess.PIPE, stderr=subprocess.PIPE)
+def run(cmd, stdout=None, input=None):
+    res = subprocess.run(cmd, stdout=stdout or subprocess.PIPE, stderr=subprocess.PIPE, input=input)
     if res.returncode != 0:
         sys.exit(f"{' '.join(cmd)} failed: {res.stderr.decode().strip()}")
     return res.stdout
@@ -116,13 +116,7 @@ def sample(bindir, model, folder, skeleton, out, n, frames, steps, sampler, seed
             cmd += ["--model", where]
     cmd += extra
     t = time.monotonic()
-    if document:
-        doc = run([f"{bindir}/skel-info", skeleton])
-        res = subprocess.run(cmd, input=doc, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        if res.returncode != 0:
-            sys.exit(f"{' '.join(cmd)} < skel-info {skeleton} failed: {res.stderr.decode().strip()}")
-    else:
-        run(cmd)
+    run(cmd, input=run([f"{bindir}/skel-info", skeleton]) if document else None)
     return time.monotonic() - t
 
 

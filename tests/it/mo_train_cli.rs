@@ -23,8 +23,12 @@ fn data(dir: &Path) -> Vec<PathBuf> {
 }
 
 fn train_args<'a>(data: &'a [PathBuf], out: &'a Path, steps: &'a str) -> Vec<&'a str> {
+    preset_args(data, out, steps, "tiny")
+}
+
+fn preset_args<'a>(data: &'a [PathBuf], out: &'a Path, steps: &'a str, preset: &'a str) -> Vec<&'a str> {
     let mut args: Vec<&str> = data.iter().map(|d| s(d)).collect();
-    args.extend(["--out", s(out), "--preset", "tiny", "--steps", steps, "--batch", "2", "--crop", "12", "--checkpoint-minutes", "1000"]);
+    args.extend(["--out", s(out), "--preset", preset, "--steps", steps, "--batch", "2", "--crop", "12", "--checkpoint-minutes", "1000"]);
     args
 }
 
@@ -383,10 +387,7 @@ fn presets_train_the_sizes_they_name() {
     let data = data(&dir);
     for (preset, width, layers) in [("tiny", 32, 2), ("compact", 64, 2)] {
         let out = dir.join(preset);
-        let mut args = train_args(&data, &out, "1");
-        let at = args.iter().position(|a| *a == "tiny").unwrap();
-        args[at] = preset;
-        ok(&run("mo-train", &args, None), preset);
+        ok(&run("mo-train", &preset_args(&data, &out, "1", preset), None), preset);
         let config = &info(&out)["config"];
         assert_eq!((config["width"].as_u64(), config["layers"].as_u64()), (Some(width), Some(layers)), "{preset}: {config}");
     }

@@ -85,6 +85,20 @@ fn without_first_frames(text: &str, drop: usize) -> String {
 /// A trained skeleton samples the same from any of its clips: the rest pose (rig and P_S) is
 /// the one training built, from its rest clip's first frames, not the given file's. A
 /// checkpoint without the recorded rest (written before it existed) falls back to the file's.
+/// A tiny model after two steps on `data` (a clip or a folder).
+fn train_two_steps(data: &Path, model: &Path) {
+    ok(&run("mo-train", &[s(data), "--out", s(model), "--preset", "tiny", "--steps", "2", "--batch", "2", "--crop", "12", "-q"], None), "train");
+}
+
+/// One short seeded sample of `skeleton` (a clip or a document) as BVH bytes, with mo-sample's
+/// `-v` stderr.
+fn sample_bvh(dir: &Path, model: &Path, skeleton: &Path, tag: &str) -> (Vec<u8>, String) {
+    let bvh = dir.join(format!("{tag}.bvh"));
+    let out = run("mo-sample", &[s(skeleton), "--model", s(model), "--frames", "12", "--steps", "3", "--seed", "5", "--bvh", s(&bvh), "-v"], None);
+    ok(&out, tag);
+    (std::fs::read(&bvh).unwrap(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
 #[test]
 fn a_trained_skeleton_samples_on_its_trained_rest_pose_from_any_clip() {
     let dir = tempdir("trained-rest");
@@ -95,17 +109,12 @@ fn a_trained_skeleton_samples_on_its_trained_rest_pose_from_any_clip() {
     std::fs::write(&first, &text).unwrap();
     std::fs::write(&later, without_first_frames(&text, 20)).unwrap();
     let model = dir.join("model");
-    ok(&run("mo-train", &[s(&data), "--out", s(&model), "--preset", "tiny", "--steps", "2", "--batch", "2", "--crop", "12", "-q"], None), "train");
+    train_two_steps(&data, &model);
     let read = |p: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
     let info = read(&model.join("checkpoint.json"));
     let rest = &info["skeletons"][0]["rest"];
     assert_eq!(rest["file"].as_str(), Some("a_walk.bvh"), "{rest}");
-    let sample = |clip: &Path, tag: &str| {
-        let bvh = dir.join(format!("{tag}.bvh"));
-        let out = run("mo-sample", &[s(clip), "--model", s(&model), "--frames", "12", "--steps", "3", "--seed", "5", "--bvh", s(&bvh), "-v"], None);
-        ok(&out, tag);
-        (std::fs::read(&bvh).unwrap(), String::from_utf8_lossy(&out.stderr).into_owned())
-    };
+    let sample = |clip: &Path, tag: &str| sample_bvh(&dir, &model, clip, tag);
     let (from_first, _) = sample(&first, "first");
     let (from_later, said) = sample(&later, "later");
     assert!(said.contains("its rest pose is the one training used (frame 0 of a_walk.bvh)"), "{said}");
@@ -126,10 +135,7 @@ fn an_untrained_skeleton_samples_alike_from_its_file_and_its_document() {
     // skeleton the model never saw, so `skel-info FILE | mo-sample` is `mo-sample FILE`.
     let dir = tempdir("file-document");
     let model = dir.join("model");
-    ok(
-        &run("mo-train", &[s(&example("quadruped.bvh")), "--out", s(&model), "--preset", "tiny", "--steps", "2", "--batch", "2", "--crop", "12", "-q"], None),
-        "train",
-    );
+    train_two_steps(&example("quadruped.bvh"), &model);
     let dragon = example("dragon.bvh");
     let info = run("skel-info", &[s(&dragon)], None);
     ok(&info, "skel-info");
@@ -137,12 +143,7 @@ fn an_untrained_skeleton_samples_alike_from_its_file_and_its_document() {
     assert!(document["anytop"]["stats"].is_object(), "the document carries statistics");
     let doc_path = dir.join("dragon.json");
     std::fs::write(&doc_path, &info.stdout).unwrap();
-    let sample = |skeleton: &Path, tag: &str| {
-        let npy = dir.join(format!("{tag}.npy"));
-        let out = run("mo-sample", &[s(skeleton), "--model", s(&model), "--frames", "12", "--steps", "3", "--seed", "5", "-o", s(&npy), "-v"], None);
-        ok(&out, tag);
-        (std::fs::read(&npy).unwrap(), String::from_utf8_lossy(&out.stderr).into_owned())
-    };
+    let sample = |skeleton: &Path, tag: &str| sample_bvh(&dir, &model, skeleton, tag);
     let (from_file, said) = sample(&dragon, "file");
     assert!(said.contains("not a trained skeleton: normalising by its rest pose"), "{said}");
     let (from_document, _) = sample(&doc_path, "document");
