@@ -105,7 +105,7 @@ fn main() {
         let loaded = load_motions(&files, &LoadOptions::default()).expect("readable BVH files");
         let clips = loaded;
         let names = NameTable::builtin().expect("the built-in name table");
-        TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation { probability: 0.0, variants: 0, seed }).expect("a training set").0
+        TrainSet::build(clips, names, topology::DEFAULT_DMAX, &Augmentation { seed, ..Augmentation::none() }).expect("a training set").0
     };
     let set = build_set();
     let joints: Vec<String> = set.skeletons.iter().map(|s| format!("{} {}", s.name, s.skeleton.len())).collect();
@@ -131,6 +131,7 @@ fn main() {
         weighting: None,
         augment: 0.0,
         augment_variants: 0,
+        variant_stats: Default::default(),
     };
     let dev = Device::Cpu;
     let scratch = std::env::temp_dir().join(format!("menagerie-train-bench-{}", std::process::id()));

@@ -175,6 +175,9 @@ pub struct CheckpointInfo {
     pub augment: f64,
     #[serde(default)]
     pub augment_variants: usize,
+    /// How the variants were normalised (measured in checkpoints written before the choice).
+    #[serde(default, skip_serializing_if = "is_measured")]
+    pub variant_stats: crate::diffusion::data::VariantStats,
     /// Decay of the weights' moving average that `model.safetensors` holds (`ema.rs`); 0 = the
     /// raw weights (and checkpoints written before the average existed).
     #[serde(default)]
@@ -200,6 +203,10 @@ pub struct CheckpointInfo {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub init: Option<String>,
     pub skeletons: Vec<TrainedSkeleton>,
+}
+
+fn is_measured(v: &crate::diffusion::data::VariantStats) -> bool {
+    *v == crate::diffusion::data::VariantStats::Measured
 }
 
 fn no_shift() -> f64 {

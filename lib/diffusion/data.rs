@@ -72,6 +72,25 @@ pub struct Augmentation {
     pub variants: usize,
     /// Seeds the choice of edits, so the same seed gives the same variants.
     pub seed: u64,
+    /// How the variants are normalised (see `VariantStats`).
+    pub stats: VariantStats,
+}
+
+/// How augmented variants are normalised.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum VariantStats {
+    /// By their own clips' statistics, as every trained skeleton is (and as upstream does).
+    #[default]
+    Measured,
+    /// As sampling normalises a skeleton the model never saw (`condition::fallback_stats`:
+    /// the rest pose as the mean, the skeletons' average spreads), so that the model learns
+    /// the condition it gets zero-shot. Why: the built-in compact model (step 15,462) sampled
+    /// its own trained quadruped at 0.32 of the clips' motion energy under that fallback
+    /// against 0.98 under its statistics, and with the trained means but the fallback's
+    /// spreads at 1.07: the rest pose as the mean (which makes the rest row P_S all zeros)
+    /// is what stills a skeleton it never saw (models/zoo-compact/MODEL_CARD.md).
+    Fallback,
 }
 
 impl Augmentation {
@@ -81,12 +100,12 @@ impl Augmentation {
 
     /// No augmentation.
     pub fn none() -> Augmentation {
-        Augmentation { probability: 0.0, variants: 0, seed: 0 }
+        Augmentation { probability: 0.0, variants: 0, seed: 0, stats: VariantStats::Measured }
     }
 
     /// The defaults with `seed`.
     pub fn with_seed(seed: u64) -> Augmentation {
-        Augmentation { probability: Self::DEFAULT_PROBABILITY, variants: Self::DEFAULT_VARIANTS, seed }
+        Augmentation { probability: Self::DEFAULT_PROBABILITY, variants: Self::DEFAULT_VARIANTS, seed, stats: VariantStats::Measured }
     }
 }
 
@@ -202,6 +221,7 @@ fn prepare<'a>(
     clips: impl Iterator<Item = (String, Cow<'a, Motion>)>,
     names: &NameTable,
     dmax: usize,
+    fallback: Option<&[&AnyTopStats]>,
     dropped: &mut Vec<String>,
 ) -> Result<Option<SkeletonData>, DataError> {
     let (rest_name, rest_motion) = rest;
@@ -221,7 +241,10 @@ fn prepare<'a>(
         return Ok(None);
     }
     let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: name.clone(), why: e.to_string() };
-    let stats = AnyTopStats::compute(features.iter()).map_err(|e| fail(&e))?;
+    let stats = match fallback {
+        Some(trained) => crate::diffusion::condition::fallback_stats(&section.rest_row, trained).map_err(|e| fail(&e))?,
+        None => AnyTopStats::compute(features.iter()).map_err(|e| fail(&e))?,
+    };
     for f in &mut features {
         stats.normalise(f).map_err(|e| fail(&e))?;
     }
@@ -275,6 +298,7 @@ fn variants_of(
     aug: &Augmentation,
     names: &NameTable,
     dmax: usize,
+    fallback: Option<&[&AnyTopStats]>,
 ) -> (Vec<SkeletonData>, Vec<String>) {
     let (mut out, mut skipped) = (Vec::new(), Vec::new());
     for v in 0..aug.variants {
@@ -309,7 +333,7 @@ fn variants_of(
         });
         let mut ignored = Vec::new();
         let name = format!("{}__{tag}_v{v}", base.name);
-        match prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, names, dmax, &mut ignored) {
+        match prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, names, dmax, fallback, &mut ignored) {
             Ok(Some(data)) => out.push(data),
             Ok(None) => {}
             Err(e) => skipped.push(format!("{name}: {e}")),
@@ -341,19 +365,28 @@ impl TrainSet {
         let mut dropped = Vec::new();
         let mut skipped_variants = Vec::new();
         let mut first_short = None;
+        let mut prepared = Vec::with_capacity(groups.len());
         for (index, (group, name)) in groups.into_iter().zip(group_names).enumerate() {
-            let rest = group.iter().find(|c| anytop::names_tpose(&c.name)).unwrap_or(&group[0]);
+            let rest = group.iter().position(|c| anytop::names_tpose(&c.name)).unwrap_or(0);
             let skeleton = group[0].skeleton.clone();
             let clips = group.iter().map(|c| (c.name.clone(), Cow::Borrowed(&c.motion)));
             // A skeleton with no croppable clip (a lone bind-pose file) is left out, its clips
             // reported as dropped; only a set with nothing left is an error.
-            let Some(data) = prepare(name, skeleton, (&rest.name, &rest.motion), clips, names, dmax, &mut dropped)? else {
+            let Some(data) = prepare(name, skeleton, (&group[rest].name, &group[rest].motion), clips, names, dmax, None, &mut dropped)? else {
                 first_short.get_or_insert_with(|| group[0].name.clone());
                 continue;
             };
+            prepared.push((index, group, rest, data));
+        }
+        // The variants come second: normalised as unseen skeletons, they need every
+        // skeleton's statistics (the fallback's spreads are their average, as at sampling).
+        let trained: Vec<AnyTopStats> = prepared.iter().map(|(_, _, _, d)| d.stats.clone()).collect();
+        let trained: Vec<&AnyTopStats> = trained.iter().collect();
+        let fallback = (aug.stats == VariantStats::Fallback).then_some(&trained[..]);
+        for (index, group, rest, data) in prepared {
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
-            let (variants, skipped) = variants_of(index, &data, &group, rest, &wanted, names, dmax);
+            let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, names, dmax, fallback);
             augmented.push(variants);
             skipped_variants.extend(skipped);
             skeletons.push(data);
@@ -589,6 +622,29 @@ mod tests {
         assert_eq!(shape(&set), shape(&again), "same seed, same variants");
         let other = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::with_seed(8)).unwrap().0;
         assert_ne!(shape(&set), shape(&other), "the seed chooses the edits");
+    }
+
+    #[test]
+    fn fallback_variants_are_normalised_as_sampling_normalises_an_unseen_skeleton() {
+        let names = NameTable::builtin().unwrap();
+        let measured = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::with_seed(7)).unwrap().0;
+        let aug = Augmentation { stats: VariantStats::Fallback, ..Augmentation::with_seed(7) };
+        let set = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug).unwrap().0;
+        let trained: Vec<&AnyTopStats> = set.skeletons.iter().map(|s| &s.stats).collect();
+        // The skeletons themselves keep their measured statistics; only the variants change.
+        for (a, b) in set.skeletons.iter().zip(&measured.skeletons) {
+            assert_eq!((&a.stats.mean, &a.rest_row), (&b.stats.mean, &b.rest_row), "{}", a.name);
+        }
+        let mut variants = 0;
+        for (v, m) in set.augmented.iter().flatten().zip(measured.augmented.iter().flatten()) {
+            assert_eq!((&v.name, v.skeleton.len()), (&m.name, m.skeleton.len()), "the same edits");
+            let expected = crate::diffusion::condition::fallback_stats(&v.section.rest_row, &trained).unwrap();
+            assert_eq!((&v.stats.mean, &v.stats.std), (&expected.mean, &expected.std), "{}", v.name);
+            assert!(v.rest_row.iter().all(|&x| x == 0.0), "{}: the rest pose is the mean, so P_S is zeros", v.name);
+            assert_ne!(v.clips[0].data, m.clips[0].data, "{}: the same frames, normalised otherwise", v.name);
+            variants += 1;
+        }
+        assert!(variants >= set.skeletons.len());
     }
 
     #[test]
