@@ -211,6 +211,16 @@ pub fn rest_record(skeleton: &Skeleton, file: &str, rest: &Motion) -> Result<Any
     AnyTopSection::new(skeleton, &rest.first_frames(2), &RigOptions { rest_source, ..RigOptions::default() })
 }
 
+/// What preparing a skeleton needs besides its clips.
+#[derive(Clone, Copy)]
+struct Preparation<'a> {
+    names: &'a NameTable,
+    dmax: usize,
+    /// `Some(trained skeletons' statistics)`: normalise by `condition::fallback_stats` of
+    /// them instead of the clips' own.
+    fallback: Option<&'a [&'a AnyTopStats]>,
+}
+
 /// Prepare one skeleton from its clips: rig and P_S from `rest` (file name, motion), features
 /// of every clip long enough (the others go to `dropped`), statistics, topology and names.
 /// `None` when no clip is long enough.
@@ -219,9 +229,7 @@ fn prepare<'a>(
     skeleton: Skeleton,
     rest: (&str, &Motion),
     clips: impl Iterator<Item = (String, Cow<'a, Motion>)>,
-    names: &NameTable,
-    dmax: usize,
-    fallback: Option<&[&AnyTopStats]>,
+    how: Preparation,
     dropped: &mut Vec<String>,
 ) -> Result<Option<SkeletonData>, DataError> {
     let (rest_name, rest_motion) = rest;
@@ -241,7 +249,7 @@ fn prepare<'a>(
         return Ok(None);
     }
     let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: name.clone(), why: e.to_string() };
-    let stats = match fallback {
+    let stats = match how.fallback {
         Some(trained) => crate::diffusion::condition::fallback_stats(&section.rest_row, trained).map_err(|e| fail(&e))?,
         None => AnyTopStats::compute(features.iter()).map_err(|e| fail(&e))?,
     };
@@ -252,8 +260,8 @@ fn prepare<'a>(
     stats.normalise(&mut rest).map_err(|e| fail(&e))?;
     Ok(Some(SkeletonData {
         relations: topology::relations(&skeleton),
-        distances: topology::distances(&skeleton, dmax),
-        names: names.embed_skeleton(&skeleton),
+        distances: topology::distances(&skeleton, how.dmax),
+        names: how.names.embed_skeleton(&skeleton),
         rest_row: rest.data,
         rest: (rest_name.to_string(), rest_motion.first_frames(2)),
         name,
@@ -290,16 +298,7 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
 /// Variants whose edit changes nothing, or whose clips are all too short, are left out; so are
 /// variants that cannot be prepared (returned with the reason): an augmentation is never
 /// worth failing a training run for.
-fn variants_of(
-    index: usize,
-    base: &SkeletonData,
-    group: &[Clip],
-    rest: &Clip,
-    aug: &Augmentation,
-    names: &NameTable,
-    dmax: usize,
-    fallback: Option<&[&AnyTopStats]>,
-) -> (Vec<SkeletonData>, Vec<String>) {
+fn variants_of(index: usize, base: &SkeletonData, group: &[Clip], rest: &Clip, aug: &Augmentation, how: Preparation) -> (Vec<SkeletonData>, Vec<String>) {
     let (mut out, mut skipped) = (Vec::new(), Vec::new());
     for v in 0..aug.variants {
         // One stream per (seed, skeleton, variant): adding a skeleton or a variant leaves the
@@ -333,7 +332,7 @@ fn variants_of(
         });
         let mut ignored = Vec::new();
         let name = format!("{}__{tag}_v{v}", base.name);
-        match prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, names, dmax, fallback, &mut ignored) {
+        match prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, how, &mut ignored) {
             Ok(Some(data)) => out.push(data),
             Ok(None) => {}
             Err(e) => skipped.push(format!("{name}: {e}")),
@@ -372,7 +371,9 @@ impl TrainSet {
             let clips = group.iter().map(|c| (c.name.clone(), Cow::Borrowed(&c.motion)));
             // A skeleton with no croppable clip (a lone bind-pose file) is left out, its clips
             // reported as dropped; only a set with nothing left is an error.
-            let Some(data) = prepare(name, skeleton, (&group[rest].name, &group[rest].motion), clips, names, dmax, None, &mut dropped)? else {
+            let Some(data) =
+                prepare(name, skeleton, (&group[rest].name, &group[rest].motion), clips, Preparation { names, dmax, fallback: None }, &mut dropped)?
+            else {
                 first_short.get_or_insert_with(|| group[0].name.clone());
                 continue;
             };
@@ -386,7 +387,7 @@ impl TrainSet {
         for (index, group, rest, data) in prepared {
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
-            let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, names, dmax, fallback);
+            let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, Preparation { names, dmax, fallback });
             augmented.push(variants);
             skipped_variants.extend(skipped);
             skeletons.push(data);
