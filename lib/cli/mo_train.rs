@@ -43,7 +43,10 @@ EXAMPLES:
 /// statistics, topology and names. Each clip (or, when a skeleton has fewer clips than
 /// variants, a piece of one) is re-encoded for one variant only, so feature memory at most
 /// about doubles. A draw then uses one of the variants with probability --augment (default 2/3:
-/// the reference picks none / remove / add uniformly). --augment 0 turns it off.
+/// the reference picks none / remove / add uniformly). --augment 0 turns it off. With
+/// --variant-stats fallback the variants are normalised as mo-sample normalises a skeleton the
+/// model never saw (its rest pose as the mean): a model trained only on its skeletons' own
+/// statistics leaves unseen skeletons standing (models/zoo-compact/MODEL_CARD.md).
 ///
 /// Checkpoints go to --out (model.safetensors, optimizer.safetensors, checkpoint.json) every
 /// --checkpoint-minutes and at the end; --resume continues from the one there, exactly as the
