@@ -131,7 +131,7 @@ fn main() {
         weighting: None,
         augment: 0.0,
         augment_variants: 0,
-        variant_stats: Default::default(),
+        fallback_stats: Default::default(),
     };
     let dev = Device::Cpu;
     let scratch = std::env::temp_dir().join(format!("menagerie-train-bench-{}", std::process::id()));

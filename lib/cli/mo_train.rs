@@ -3,7 +3,7 @@
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
-use crate::diffusion::data::{Augmentation, TrainSet, VariantStats};
+use crate::diffusion::data::{Augmentation, FallbackStats, TrainSet};
 use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::embed::NameTable;
 use crate::nn::{DenoiserConfig, Preset};
@@ -43,10 +43,12 @@ EXAMPLES:
 /// statistics, topology and names. Each clip (or, when a skeleton has fewer clips than
 /// variants, a piece of one) is re-encoded for one variant only, so feature memory at most
 /// about doubles. A draw then uses one of the variants with probability --augment (default 2/3:
-/// the reference picks none / remove / add uniformly). --augment 0 turns it off. With
-/// --variant-stats fallback the variants are normalised as mo-sample normalises a skeleton the
-/// model never saw (its rest pose as the mean): a model trained only on its skeletons' own
-/// statistics leaves unseen skeletons standing (models/zoo-compact/MODEL_CARD.md).
+/// the reference picks none / remove / add uniformly). --augment 0 turns it off.
+///
+/// --fallback-stats variants (or all) normalises the variants (or everything) as mo-sample
+/// normalises a skeleton the model never saw, its rest pose as the mean: a model trained only on
+/// its skeletons' own statistics leaves unseen skeletons standing
+/// (models/zoo-compact/MODEL_CARD.md).
 ///
 /// Checkpoints go to --out (model.safetensors, optimizer.safetensors, checkpoint.json) every
 /// --checkpoint-minutes and at the end; --resume continues from the one there, exactly as the
@@ -136,13 +138,12 @@ pub struct Args {
     /// Augmented variants prepared per skeleton (alternately removing and adding joints).
     #[arg(long, value_name = "N", default_value_t = Augmentation::DEFAULT_VARIANTS as u64, value_parser = clap::value_parser!(u64).range(0..=64))]
     pub augment_variants: u64,
-    /// anytop: how the augmented variants are normalised: by their own clips' statistics
-    /// (measured, upstream's), or as sampling normalises a skeleton the model never saw
-    /// (fallback: the rest pose as the mean, the skeletons' average spreads), so that the model
-    /// learns the condition it gets zero-shot [default: measured; with --resume the
-    /// checkpoint's]
-    #[arg(long, value_name = "HOW", value_enum)]
-    pub variant_stats: Option<VariantStats>,
+    /// anytop: what training normalises as sampling normalises a skeleton the model never saw
+    /// (the rest pose as the mean, the skeletons' average spreads) instead of by its own clips'
+    /// statistics, so that the model learns the condition it gets zero-shot [default: none;
+    /// with --resume the checkpoint's]
+    #[arg(long, value_name = "WHAT", value_enum)]
+    pub fallback_stats: Option<FallbackStats>,
     /// anytop: decay of the moving average of the weights that the saved model holds and
     /// mo-sample samples with (the raw weights are kept beside it for --resume). 0 = save the
     /// raw weights. An average over about 1/(1 - decay) steps.
@@ -256,7 +257,7 @@ struct Previous {
     crop: Option<u64>,
     augment: f64,
     #[serde(default)]
-    variant_stats: VariantStats,
+    fallback_stats: FallbackStats,
 }
 
 impl Previous {
@@ -272,7 +273,7 @@ impl Previous {
 struct Resolved {
     lr: f64,
     augment: f64,
-    variant_stats: VariantStats,
+    fallback_stats: FallbackStats,
     steps: u64,
     batch: u64,
     /// `None`: the architecture's own (sata: the preset's window).
@@ -287,7 +288,7 @@ impl Resolved {
         Resolved {
             lr: pick(args.lr, previous.as_ref().map(|p| p.lr), INIT_LR, 1e-4),
             augment: pick(args.augment, previous.as_ref().map(|p| p.augment), 0.0, 2.0 / 3.0),
-            variant_stats: args.variant_stats.or(previous.as_ref().map(|p| p.variant_stats)).unwrap_or_default(),
+            fallback_stats: args.fallback_stats.or(previous.as_ref().map(|p| p.fallback_stats)).unwrap_or_default(),
             steps: args.steps.unwrap_or(if args.minutes.is_some() { bounds::MAX_TRAIN_STEPS } else { 10_000 }),
             batch: args.batch.or(previous.as_ref().map(|p| p.batch)).unwrap_or(if fine_tune { INIT_BATCH } else { 16 }),
             crop: args.crop.or(previous.as_ref().and_then(|p| p.crop)).or(fine_tune.then_some(INIT_CROP)),
@@ -303,8 +304,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.init.is_some() && args.arch != Arch::Anytop {
         bail!("--init fine-tunes the diffusion model (--arch anytop), not --arch sata");
     }
-    if args.variant_stats.is_some() && args.arch != Arch::Anytop {
-        bail!("--variant-stats is the diffusion model's (--arch anytop); --arch sata normalises every skeleton by its clips");
+    if args.fallback_stats.is_some() && args.arch != Arch::Anytop {
+        bail!("--fallback-stats is the diffusion model's (--arch anytop); --arch sata normalises every skeleton by its clips");
     }
     // Before any work or message: --out must be (or become) a directory.
     if args.out.exists() && !args.out.is_dir() {
@@ -334,7 +335,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         lambda_vel: args.lambda_vel,
         augment: resolved.augment,
         augment_variants: args.augment_variants as usize,
-        variant_stats: resolved.variant_stats,
+        fallback_stats: resolved.fallback_stats,
         ema: args.ema,
         noise_shift: args.noise_shift,
         position_jitter: args.position_jitter.map(|n| n as usize),
@@ -440,7 +441,7 @@ fn train(args: &Args, resolved: &Resolved, first: u64, trainer: &mut impl Traine
 fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
     let clips = load_motions(&expand_inputs(&args.data)?, &LoadOptions::default())?;
     let names = NameTable::builtin().context("the built-in joint-name table")?;
-    let augmentation = Augmentation { probability: resolved.augment, variants: args.augment_variants as usize, seed, stats: resolved.variant_stats };
+    let augmentation = Augmentation { probability: resolved.augment, variants: args.augment_variants as usize, seed, stats: resolved.fallback_stats };
     let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;
     set.report(&dropped, args.common.verbose).iter().for_each(|line| say(args, line));
     Ok(set)

@@ -176,8 +176,8 @@ pub struct CheckpointInfo {
     #[serde(default)]
     pub augment_variants: usize,
     /// How the variants were normalised (measured in checkpoints written before the choice).
-    #[serde(default, skip_serializing_if = "is_measured")]
-    pub variant_stats: crate::diffusion::data::VariantStats,
+    #[serde(default, skip_serializing_if = "is_no_fallback")]
+    pub fallback_stats: crate::diffusion::data::FallbackStats,
     /// Decay of the weights' moving average that `model.safetensors` holds (`ema.rs`); 0 = the
     /// raw weights (and checkpoints written before the average existed).
     #[serde(default)]
@@ -205,8 +205,8 @@ pub struct CheckpointInfo {
     pub skeletons: Vec<TrainedSkeleton>,
 }
 
-fn is_measured(v: &crate::diffusion::data::VariantStats) -> bool {
-    *v == crate::diffusion::data::VariantStats::Measured
+fn is_no_fallback(v: &crate::diffusion::data::FallbackStats) -> bool {
+    *v == crate::diffusion::data::FallbackStats::None
 }
 
 fn no_shift() -> f64 {

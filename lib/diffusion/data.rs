@@ -72,25 +72,29 @@ pub struct Augmentation {
     pub variants: usize,
     /// Seeds the choice of edits, so the same seed gives the same variants.
     pub seed: u64,
-    /// How the variants are normalised (see `VariantStats`).
-    pub stats: VariantStats,
+    /// Which draws are normalised as an unseen skeleton (see `FallbackStats`).
+    pub stats: FallbackStats,
 }
 
-/// How augmented variants are normalised.
+/// Which skeletons training normalises as sampling normalises a skeleton the model never saw
+/// (`condition::fallback_stats`: the rest pose as the mean, the skeletons' average spreads)
+/// rather than by their own clips' statistics. Why: the built-in compact model (step 15,462)
+/// sampled its own trained quadruped at 0.32 of the clips' motion energy under the fallback
+/// against 0.98 under its statistics, and at 1.07 with its means but the fallback's spreads:
+/// the rest pose as the mean (which makes the rest row P_S all zeros), a condition it never
+/// trained on, is what stills a skeleton it never saw (models/zoo-compact/MODEL_CARD.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
-pub enum VariantStats {
-    /// By their own clips' statistics, as every trained skeleton is (and as upstream does).
+pub enum FallbackStats {
+    /// Every skeleton and variant by its own clips (upstream's way).
     #[default]
-    Measured,
-    /// As sampling normalises a skeleton the model never saw (`condition::fallback_stats`:
-    /// the rest pose as the mean, the skeletons' average spreads), so that the model learns
-    /// the condition it gets zero-shot. Why: the built-in compact model (step 15,462) sampled
-    /// its own trained quadruped at 0.32 of the clips' motion energy under that fallback
-    /// against 0.98 under its statistics, and with the trained means but the fallback's
-    /// spreads at 1.07: the rest pose as the mean (which makes the rest row P_S all zeros)
-    /// is what stills a skeleton it never saw (models/zoo-compact/MODEL_CARD.md).
-    Fallback,
+    None,
+    /// The augmented variants (new topologies every one); the skeletons keep theirs, which
+    /// sampling uses for them.
+    Variants,
+    /// Every skeleton and variant, so the model has one condition; the checkpoint then
+    /// records the fallback as each skeleton's statistics, and sampling uses it for them too.
+    All,
 }
 
 impl Augmentation {
@@ -100,12 +104,12 @@ impl Augmentation {
 
     /// No augmentation.
     pub fn none() -> Augmentation {
-        Augmentation { probability: 0.0, variants: 0, seed: 0, stats: VariantStats::Measured }
+        Augmentation { probability: 0.0, variants: 0, seed: 0, stats: FallbackStats::None }
     }
 
     /// The defaults with `seed`.
     pub fn with_seed(seed: u64) -> Augmentation {
-        Augmentation { probability: Self::DEFAULT_PROBABILITY, variants: Self::DEFAULT_VARIANTS, seed, stats: VariantStats::Measured }
+        Augmentation { probability: Self::DEFAULT_PROBABILITY, variants: Self::DEFAULT_VARIANTS, seed, stats: FallbackStats::None }
     }
 }
 
@@ -383,8 +387,16 @@ impl TrainSet {
         // skeleton's statistics (the fallback's spreads are their average, as at sampling).
         let trained: Vec<AnyTopStats> = prepared.iter().map(|(_, _, _, d)| d.stats.clone()).collect();
         let trained: Vec<&AnyTopStats> = trained.iter().collect();
-        let fallback = (aug.stats == VariantStats::Fallback).then_some(&trained[..]);
-        for (index, group, rest, data) in prepared {
+        let fallback = (aug.stats != FallbackStats::None).then_some(&trained[..]);
+        for (index, group, rest, mut data) in prepared {
+            if aug.stats == FallbackStats::All {
+                // Prepared again (rather than renormalised) so that one code path normalises.
+                let clips = group.iter().map(|c| (c.name.clone(), Cow::Borrowed(&c.motion)));
+                let how = Preparation { names, dmax, fallback };
+                let name = std::mem::take(&mut data.name);
+                let prepared = prepare(name, data.skeleton, (&group[rest].name, &group[rest].motion), clips, how, &mut Vec::new())?;
+                data = prepared.ok_or_else(|| DataError::TooShort { clip: group[0].name.clone() })?;
+            }
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
             let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, Preparation { names, dmax, fallback });
@@ -629,7 +641,7 @@ mod tests {
     fn fallback_variants_are_normalised_as_sampling_normalises_an_unseen_skeleton() {
         let names = NameTable::builtin().unwrap();
         let measured = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::with_seed(7)).unwrap().0;
-        let aug = Augmentation { stats: VariantStats::Fallback, ..Augmentation::with_seed(7) };
+        let aug = Augmentation { stats: FallbackStats::Variants, ..Augmentation::with_seed(7) };
         let set = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug).unwrap().0;
         let trained: Vec<&AnyTopStats> = set.skeletons.iter().map(|s| &s.stats).collect();
         // The skeletons themselves keep their measured statistics; only the variants change.
@@ -646,6 +658,27 @@ mod tests {
             variants += 1;
         }
         assert!(variants >= set.skeletons.len());
+    }
+
+    #[test]
+    fn fallback_all_normalises_the_skeletons_too_with_the_measured_average_spreads() {
+        let names = NameTable::builtin().unwrap();
+        let measured = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::with_seed(7)).unwrap().0;
+        let aug = Augmentation { stats: FallbackStats::All, ..Augmentation::with_seed(7) };
+        let set = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug).unwrap().0;
+        let trained: Vec<&AnyTopStats> = measured.skeletons.iter().map(|s| &s.stats).collect();
+        assert_eq!(set.skeletons.len(), measured.skeletons.len());
+        for (a, m) in set.skeletons.iter().zip(&measured.skeletons) {
+            assert_eq!((&a.name, a.clips.len()), (&m.name, m.clips.len()));
+            let expected = crate::diffusion::condition::fallback_stats(&a.section.rest_row, &trained).unwrap();
+            assert_eq!((&a.stats.mean, &a.stats.std), (&expected.mean, &expected.std), "{}", a.name);
+            assert!(a.rest_row.iter().all(|&x| x == 0.0), "{}", a.name);
+            assert_ne!(a.clips[0].data, m.clips[0].data, "{}", a.name);
+        }
+        // The variants are those of `variants` (the same average spreads).
+        let variants = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation { stats: FallbackStats::Variants, ..aug }).unwrap().0;
+        let stats = |s: &TrainSet| s.augmented.iter().flatten().map(|v| (v.stats.mean.clone(), v.stats.std.clone())).collect::<Vec<_>>();
+        assert_eq!(stats(&set), stats(&variants));
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! step k depends only on the seed and k (`step_rng`), and a checkpoint carries the optimiser.
 
 use super::checkpoint::{self, CheckpointInfo, TrainedRest, TrainedSkeleton};
-use super::data::{TrainSet, VariantStats};
+use super::data::{FallbackStats, TrainSet};
 use super::ema::Ema;
 use super::train::{named_vars, train_step, AdamW, LossTerms, Weighting};
 use super::Schedule;
@@ -261,7 +261,7 @@ pub struct AnyTopOptions {
     pub augment: f64,
     pub augment_variants: usize,
     /// How the augmented variants are normalised.
-    pub variant_stats: VariantStats,
+    pub fallback_stats: FallbackStats,
     /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
     /// 0 = none.
     pub ema: f64,
@@ -392,7 +392,7 @@ impl AnyTopResume {
             || i.seed != opts.seed
             || i.augment != opts.augment
             || i.augment_variants != opts.augment_variants
-            || i.variant_stats != opts.variant_stats
+            || i.fallback_stats != opts.fallback_stats
             || opts.position_jitter.is_some_and(|j| j != i.position_jitter)
     }
 
@@ -448,7 +448,7 @@ impl AnyTopTrainer {
             dmax: base.map_or(crate::skeleton::topology::DEFAULT_DMAX, |b| b.dmax),
             augment: 0.0,
             augment_variants: 0,
-            variant_stats: VariantStats::Measured,
+            fallback_stats: FallbackStats::None,
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
             position_jitter: base.map_or(DEFAULT_POSITION_JITTER, |b| b.position_jitter),
@@ -493,7 +493,7 @@ impl AnyTopTrainer {
         info.crop = opts.crop;
         info.augment = opts.augment;
         info.augment_variants = opts.augment_variants;
-        info.variant_stats = opts.variant_stats;
+        info.fallback_stats = opts.fallback_stats;
         info.skeletons = set
             .skeletons
             .iter()

@@ -105,31 +105,31 @@ fn augmentation_flags_and_skeleton_names_are_recorded() {
     }
 }
 
-/// --variant-stats is recorded only when it is not upstream's (old checkpoints read as
+/// --fallback-stats is recorded only when it is not upstream's (old checkpoints read as
 /// measured), a resume keeps it unless told otherwise, and SATA refuses it.
 #[test]
-fn variant_stats_are_recorded_and_kept_by_resume() {
-    let dir = tempdir("train-variant-stats");
+fn fallback_stats_are_recorded_and_kept_by_resume() {
+    let dir = tempdir("train-fallback-stats");
     let data = data(&dir);
     let (plain, fallback) = (dir.join("plain"), dir.join("fallback"));
     ok(&run("mo-train", &train_args(&data, &plain, "1"), None), "measured");
-    assert!(info(&plain).get("variant_stats").is_none(), "measured is the default and not written");
+    assert!(info(&plain).get("fallback_stats").is_none(), "measured is the default and not written");
     let mut args = train_args(&data, &fallback, "1");
-    args.extend(["--variant-stats", "fallback"]);
+    args.extend(["--fallback-stats", "variants"]);
     ok(&run("mo-train", &args, None), "fallback");
-    assert_eq!(info(&fallback)["variant_stats"], "fallback");
+    assert_eq!(info(&fallback)["fallback_stats"], "variants");
     let mut args = train_args(&data, &fallback, "2");
     args.push("--resume");
     let resumed = run("mo-train", &args, None);
     ok(&resumed, "resume");
     assert!(!String::from_utf8_lossy(&resumed.stderr).contains("differ from the checkpoint"), "the same run goes on");
-    assert_eq!((info(&fallback)["step"].as_u64(), info(&fallback)["variant_stats"].as_str()), (Some(2), Some("fallback")));
+    assert_eq!((info(&fallback)["step"].as_u64(), info(&fallback)["fallback_stats"].as_str()), (Some(2), Some("variants")));
     let sata = dir.join("sata");
     let mut args = train_args(&data, &sata, "1");
-    args.extend(["--arch", "sata", "--variant-stats", "fallback"]);
+    args.extend(["--arch", "sata", "--fallback-stats", "variants"]);
     let out = run("mo-train", &args, None);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.code() == Some(2) && stderr.contains("--variant-stats") && !sata.exists(), "{stderr}");
+    assert!(out.status.code() == Some(2) && stderr.contains("--fallback-stats") && !sata.exists(), "{stderr}");
 }
 
 /// A learning rate that blows the model up: the first non-finite loss stops training with exit
