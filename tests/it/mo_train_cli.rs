@@ -105,8 +105,8 @@ fn augmentation_flags_and_skeleton_names_are_recorded() {
     }
 }
 
-/// --fallback-stats is recorded only when it is not upstream's (old checkpoints read as
-/// measured), a resume keeps it unless told otherwise, and SATA refuses it.
+/// --fallback-stats is recorded only when it is not none, upstream's way (old checkpoints read as
+/// none), a resume keeps it unless told otherwise, and SATA refuses it.
 #[test]
 fn fallback_stats_are_recorded_and_kept_by_resume() {
     let dir = tempdir("train-fallback-stats");
