@@ -175,7 +175,8 @@ pub struct CheckpointInfo {
     pub augment: f64,
     #[serde(default)]
     pub augment_variants: usize,
-    /// How the variants were normalised (measured in checkpoints written before the choice).
+    /// What training normalised by the fallback statistics (`data::FallbackStats`; none in
+    /// checkpoints written before the choice).
     #[serde(default, skip_serializing_if = "is_no_fallback")]
     pub fallback_stats: crate::diffusion::data::FallbackStats,
     /// Decay of the weights' moving average that `model.safetensors` holds (`ema.rs`); 0 = the

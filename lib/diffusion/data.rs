@@ -220,14 +220,12 @@ pub fn rest_record(skeleton: &Skeleton, file: &str, rest: &Motion) -> Result<Any
 struct Preparation<'a> {
     names: &'a NameTable,
     dmax: usize,
-    /// `Some(trained skeletons' statistics)`: normalise by `condition::fallback_stats` of
-    /// them instead of the clips' own.
-    fallback: Option<&'a [&'a AnyTopStats]>,
 }
 
 /// Prepare one skeleton from its clips: rig and P_S from `rest` (file name, motion), features
-/// of every clip long enough (the others go to `dropped`), statistics, topology and names.
-/// `None` when no clip is long enough.
+/// of every clip long enough (the others go to `dropped`), the clips' statistics, topology and
+/// names. Clips and P_S are left unnormalised: `normalised` finishes the skeleton once it is
+/// known which statistics it trains under. `None` when no clip is long enough.
 fn prepare<'a>(
     name: String,
     skeleton: Skeleton,
@@ -252,21 +250,12 @@ fn prepare<'a>(
     if features.is_empty() {
         return Ok(None);
     }
-    let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: name.clone(), why: e.to_string() };
-    let stats = match how.fallback {
-        Some(trained) => crate::diffusion::condition::fallback_stats(&section.rest_row, trained).map_err(|e| fail(&e))?,
-        None => AnyTopStats::compute(features.iter()).map_err(|e| fail(&e))?,
-    };
-    for f in &mut features {
-        stats.normalise(f).map_err(|e| fail(&e))?;
-    }
-    let mut rest = Features { frames: 1, joints: skeleton.len(), dims: anytop::FEATURE_DIMS, data: section.rest_row.concat() };
-    stats.normalise(&mut rest).map_err(|e| fail(&e))?;
+    let stats = AnyTopStats::compute(features.iter()).map_err(|e| DataError::Clip { clip: name.clone(), why: e.to_string() })?;
     Ok(Some(SkeletonData {
         relations: topology::relations(&skeleton),
         distances: topology::distances(&skeleton, how.dmax),
         names: how.names.embed_skeleton(&skeleton),
-        rest_row: rest.data,
+        rest_row: section.rest_row.concat(),
         rest: (rest_name.to_string(), rest_motion.first_frames(2)),
         name,
         skeleton,
@@ -297,12 +286,36 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
     vec![(clip, start..start + size)]
 }
 
+/// `data` as `prepare` left it, normalised by its clips' statistics, or with `fallback`
+/// (the trained skeletons' statistics) by `condition::fallback_stats` of them.
+fn normalised(mut data: SkeletonData, fallback: Option<&[&AnyTopStats]>) -> Result<SkeletonData, DataError> {
+    let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: data.name.clone(), why: e.to_string() };
+    if let Some(trained) = fallback {
+        data.stats = crate::diffusion::condition::fallback_stats(&data.section.rest_row, trained).map_err(|e| fail(&e))?;
+    }
+    for f in &mut data.clips {
+        data.stats.normalise(f).map_err(|e| fail(&e))?;
+    }
+    let mut rest = Features { frames: 1, joints: data.skeleton.len(), dims: anytop::FEATURE_DIMS, data: std::mem::take(&mut data.rest_row) };
+    data.stats.normalise(&mut rest).map_err(|e| fail(&e))?;
+    data.rest_row = rest.data;
+    Ok(data)
+}
+
 /// The augmented variants of one skeleton (group `index` of the set): variant `v` removes
 /// joints (`v` even) or subdivides one bone (`v` odd) and carries the frames `deal` gives it.
 /// Variants whose edit changes nothing, or whose clips are all too short, are left out; so are
 /// variants that cannot be prepared (returned with the reason): an augmentation is never
 /// worth failing a training run for.
-fn variants_of(index: usize, base: &SkeletonData, group: &[Clip], rest: &Clip, aug: &Augmentation, how: Preparation) -> (Vec<SkeletonData>, Vec<String>) {
+fn variants_of(
+    index: usize,
+    base: &SkeletonData,
+    group: &[Clip],
+    rest: &Clip,
+    aug: &Augmentation,
+    how: Preparation,
+    fallback: Option<&[&AnyTopStats]>,
+) -> (Vec<SkeletonData>, Vec<String>) {
     let (mut out, mut skipped) = (Vec::new(), Vec::new());
     for v in 0..aug.variants {
         // One stream per (seed, skeleton, variant): adding a skeleton or a variant leaves the
@@ -336,7 +349,8 @@ fn variants_of(index: usize, base: &SkeletonData, group: &[Clip], rest: &Clip, a
         });
         let mut ignored = Vec::new();
         let name = format!("{}__{tag}_v{v}", base.name);
-        match prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, how, &mut ignored) {
+        let prepared = prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, how, &mut ignored);
+        match prepared.and_then(|data| data.map(|data| normalised(data, fallback)).transpose()) {
             Ok(Some(data)) => out.push(data),
             Ok(None) => {}
             Err(e) => skipped.push(format!("{name}: {e}")),
@@ -375,31 +389,22 @@ impl TrainSet {
             let clips = group.iter().map(|c| (c.name.clone(), Cow::Borrowed(&c.motion)));
             // A skeleton with no croppable clip (a lone bind-pose file) is left out, its clips
             // reported as dropped; only a set with nothing left is an error.
-            let Some(data) =
-                prepare(name, skeleton, (&group[rest].name, &group[rest].motion), clips, Preparation { names, dmax, fallback: None }, &mut dropped)?
-            else {
+            let Some(data) = prepare(name, skeleton, (&group[rest].name, &group[rest].motion), clips, Preparation { names, dmax }, &mut dropped)? else {
                 first_short.get_or_insert_with(|| group[0].name.clone());
                 continue;
             };
             prepared.push((index, group, rest, data));
         }
-        // The variants come second: normalised as unseen skeletons, they need every
-        // skeleton's statistics (the fallback's spreads are their average, as at sampling).
+        // Normalising comes second: as unseen skeletons, skeletons and variants need every
+        // skeleton's measured statistics (the fallback's spreads are their average, as at sampling).
         let trained: Vec<AnyTopStats> = prepared.iter().map(|(_, _, _, d)| d.stats.clone()).collect();
         let trained: Vec<&AnyTopStats> = trained.iter().collect();
         let fallback = (aug.stats != FallbackStats::None).then_some(&trained[..]);
-        for (index, group, rest, mut data) in prepared {
-            if aug.stats == FallbackStats::All {
-                // Prepared again (rather than renormalised) so that one code path normalises.
-                let clips = group.iter().map(|c| (c.name.clone(), Cow::Borrowed(&c.motion)));
-                let how = Preparation { names, dmax, fallback };
-                let name = std::mem::take(&mut data.name);
-                let prepared = prepare(name, data.skeleton, (&group[rest].name, &group[rest].motion), clips, how, &mut Vec::new())?;
-                data = prepared.ok_or_else(|| DataError::TooShort { clip: group[0].name.clone() })?;
-            }
+        for (index, group, rest, data) in prepared {
+            let data = normalised(data, fallback.filter(|_| aug.stats == FallbackStats::All))?;
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
-            let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, Preparation { names, dmax, fallback });
+            let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, Preparation { names, dmax }, fallback);
             augmented.push(variants);
             skipped_variants.extend(skipped);
             skeletons.push(data);
@@ -637,12 +642,15 @@ mod tests {
         assert_ne!(shape(&set), shape(&other), "the seed chooses the edits");
     }
 
+    /// The zoo with the default augmentation (seed 7), normalised as `stats` says.
+    fn zoo_set(stats: FallbackStats) -> TrainSet {
+        let aug = Augmentation { stats, ..Augmentation::with_seed(7) };
+        TrainSet::build(zoo(), NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &aug).unwrap().0
+    }
+
     #[test]
     fn fallback_variants_are_normalised_as_sampling_normalises_an_unseen_skeleton() {
-        let names = NameTable::builtin().unwrap();
-        let measured = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::with_seed(7)).unwrap().0;
-        let aug = Augmentation { stats: FallbackStats::Variants, ..Augmentation::with_seed(7) };
-        let set = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug).unwrap().0;
+        let (measured, set) = (zoo_set(FallbackStats::None), zoo_set(FallbackStats::Variants));
         let trained: Vec<&AnyTopStats> = set.skeletons.iter().map(|s| &s.stats).collect();
         // The skeletons themselves keep their measured statistics; only the variants change.
         for (a, b) in set.skeletons.iter().zip(&measured.skeletons) {
@@ -662,10 +670,7 @@ mod tests {
 
     #[test]
     fn fallback_all_normalises_the_skeletons_too_with_the_measured_average_spreads() {
-        let names = NameTable::builtin().unwrap();
-        let measured = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation::with_seed(7)).unwrap().0;
-        let aug = Augmentation { stats: FallbackStats::All, ..Augmentation::with_seed(7) };
-        let set = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug).unwrap().0;
+        let (measured, set) = (zoo_set(FallbackStats::None), zoo_set(FallbackStats::All));
         let trained: Vec<&AnyTopStats> = measured.skeletons.iter().map(|s| &s.stats).collect();
         assert_eq!(set.skeletons.len(), measured.skeletons.len());
         for (a, m) in set.skeletons.iter().zip(&measured.skeletons) {
@@ -676,7 +681,7 @@ mod tests {
             assert_ne!(a.clips[0].data, m.clips[0].data, "{}", a.name);
         }
         // The variants are those of `variants` (the same average spreads).
-        let variants = TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &Augmentation { stats: FallbackStats::Variants, ..aug }).unwrap().0;
+        let variants = zoo_set(FallbackStats::Variants);
         let stats = |s: &TrainSet| s.augmented.iter().flatten().map(|v| (v.stats.mean.clone(), v.stats.std.clone())).collect::<Vec<_>>();
         assert_eq!(stats(&set), stats(&variants));
     }

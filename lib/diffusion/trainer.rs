@@ -260,7 +260,7 @@ pub struct AnyTopOptions {
     pub weighting: Option<Weighting>,
     pub augment: f64,
     pub augment_variants: usize,
-    /// How the augmented variants are normalised.
+    /// What is normalised by the fallback statistics (`data::FallbackStats`).
     pub fallback_stats: FallbackStats,
     /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
     /// 0 = none.

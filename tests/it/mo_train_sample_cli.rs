@@ -82,9 +82,6 @@ fn without_first_frames(text: &str, drop: usize) -> String {
     out.join("\n") + "\n"
 }
 
-/// A trained skeleton samples the same from any of its clips: the rest pose (rig and P_S) is
-/// the one training built, from its rest clip's first frames, not the given file's. A
-/// checkpoint without the recorded rest (written before it existed) falls back to the file's.
 /// A tiny model after two steps on `data` (a clip or a folder).
 fn train_two_steps(data: &Path, model: &Path) {
     ok(&run("mo-train", &[s(data), "--out", s(model), "--preset", "tiny", "--steps", "2", "--batch", "2", "--crop", "12", "-q"], None), "train");
@@ -99,6 +96,9 @@ fn sample_bvh(dir: &Path, model: &Path, skeleton: &Path, tag: &str) -> (Vec<u8>,
     (std::fs::read(&bvh).unwrap(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
+/// A trained skeleton samples the same from any of its clips: the rest pose (rig and P_S) is
+/// the one training built, from its rest clip's first frames, not the given file's. A
+/// checkpoint without the recorded rest (written before it existed) falls back to the file's.
 #[test]
 fn a_trained_skeleton_samples_on_its_trained_rest_pose_from_any_clip() {
     let dir = tempdir("trained-rest");
