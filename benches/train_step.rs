@@ -132,6 +132,7 @@ fn main() {
         augment: 0.0,
         augment_variants: 0,
         fallback_stats: Default::default(),
+        loss_units: Default::default(),
     };
     let dev = Device::Cpu;
     let scratch = std::env::temp_dir().join(format!("menagerie-train-bench-{}", std::process::id()));

@@ -3,7 +3,7 @@
 use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
-use crate::diffusion::data::{Augmentation, FallbackStats, TrainSet};
+use crate::diffusion::data::{Augmentation, FallbackStats, LossUnits, TrainSet};
 use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::embed::NameTable;
 use crate::nn::{DenoiserConfig, Preset};
@@ -144,6 +144,12 @@ pub struct Args {
     /// with --resume the checkpoint's]
     #[arg(long, value_name = "WHAT", value_enum)]
     pub fallback_stats: Option<FallbackStats>,
+    /// anytop: the units of the error of what --fallback-stats normalises: `own` measures it in
+    /// the skeleton's own clips' spreads, so a creature that moves little next to the average
+    /// spread weighs as much as one that moves a lot [default: normalised; with --resume the
+    /// checkpoint's]
+    #[arg(long, value_name = "UNITS", value_enum)]
+    pub loss_units: Option<LossUnits>,
     /// anytop: decay of the moving average of the weights that the saved model holds and
     /// mo-sample samples with (the raw weights are kept beside it for --resume). 0 = save the
     /// raw weights. An average over about 1/(1 - decay) steps.
@@ -258,6 +264,8 @@ struct Previous {
     augment: f64,
     #[serde(default)]
     fallback_stats: FallbackStats,
+    #[serde(default)]
+    loss_units: LossUnits,
 }
 
 impl Previous {
@@ -274,6 +282,7 @@ struct Resolved {
     lr: f64,
     augment: f64,
     fallback_stats: FallbackStats,
+    loss_units: LossUnits,
     steps: u64,
     batch: u64,
     /// `None`: the architecture's own (sata: the preset's window).
@@ -289,6 +298,7 @@ impl Resolved {
             lr: pick(args.lr, previous.as_ref().map(|p| p.lr), INIT_LR, 1e-4),
             augment: pick(args.augment, previous.as_ref().map(|p| p.augment), 0.0, 2.0 / 3.0),
             fallback_stats: args.fallback_stats.or(previous.as_ref().map(|p| p.fallback_stats)).unwrap_or_default(),
+            loss_units: args.loss_units.or(previous.as_ref().map(|p| p.loss_units)).unwrap_or_default(),
             steps: args.steps.unwrap_or(if args.minutes.is_some() { bounds::MAX_TRAIN_STEPS } else { 10_000 }),
             batch: args.batch.or(previous.as_ref().map(|p| p.batch)).unwrap_or(if fine_tune { INIT_BATCH } else { 16 }),
             crop: args.crop.or(previous.as_ref().and_then(|p| p.crop)).or(fine_tune.then_some(INIT_CROP)),
@@ -306,6 +316,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if args.fallback_stats.is_some() && args.arch != Arch::Anytop {
         bail!("--fallback-stats is the diffusion model's (--arch anytop); --arch sata normalises every skeleton by its clips");
+    }
+    if args.loss_units.is_some() && args.arch != Arch::Anytop {
+        bail!("--loss-units is the diffusion model's (--arch anytop); --arch sata normalises every skeleton by its clips");
+    }
+    if resolved.loss_units == LossUnits::Own && resolved.fallback_stats == FallbackStats::None {
+        bail!("--loss-units own measures the error of what --fallback-stats normalises; give --fallback-stats variants or all");
     }
     // Before any work or message: --out must be (or become) a directory.
     if args.out.exists() && !args.out.is_dir() {
@@ -336,6 +352,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         augment: resolved.augment,
         augment_variants: args.augment_variants as usize,
         fallback_stats: resolved.fallback_stats,
+        loss_units: resolved.loss_units,
         ema: args.ema,
         noise_shift: args.noise_shift,
         position_jitter: args.position_jitter.map(|n| n as usize),
@@ -441,7 +458,13 @@ fn train(args: &Args, resolved: &Resolved, first: u64, trainer: &mut impl Traine
 fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
     let clips = load_motions(&expand_inputs(&args.data)?, &LoadOptions::default())?;
     let names = NameTable::builtin().context("the built-in joint-name table")?;
-    let augmentation = Augmentation { probability: resolved.augment, variants: args.augment_variants as usize, seed, stats: resolved.fallback_stats };
+    let augmentation = Augmentation {
+        probability: resolved.augment,
+        variants: args.augment_variants as usize,
+        seed,
+        stats: resolved.fallback_stats,
+        units: resolved.loss_units,
+    };
     let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;
     set.report(&dropped, args.common.verbose).iter().for_each(|line| say(args, line));
     Ok(set)

@@ -179,6 +179,10 @@ pub struct CheckpointInfo {
     /// checkpoints written before the choice).
     #[serde(default, skip_serializing_if = "is_no_fallback")]
     pub fallback_stats: crate::diffusion::data::FallbackStats,
+    /// The units of a fallback-normalised draw's error (`data::LossUnits`; normalised in
+    /// checkpoints written before the choice).
+    #[serde(default, skip_serializing_if = "is_normalised_units")]
+    pub loss_units: crate::diffusion::data::LossUnits,
     /// Decay of the weights' moving average that `model.safetensors` holds (`ema.rs`); 0 = the
     /// raw weights (and checkpoints written before the average existed).
     #[serde(default)]
@@ -208,6 +212,10 @@ pub struct CheckpointInfo {
 
 fn is_no_fallback(v: &crate::diffusion::data::FallbackStats) -> bool {
     *v == crate::diffusion::data::FallbackStats::None
+}
+
+fn is_normalised_units(v: &crate::diffusion::data::LossUnits) -> bool {
+    *v == crate::diffusion::data::LossUnits::Normalised
 }
 
 fn no_shift() -> f64 {

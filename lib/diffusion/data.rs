@@ -61,6 +61,10 @@ pub struct SkeletonData {
     /// Normalised features `[frames, joints, 13]` of each clip.
     pub clips: Vec<Features>,
     pub clip_names: Vec<String>,
+    /// Per joint and feature (`[joints * 13]`), what an error in `stats`' units weighs in the
+    /// loss: `None` counts every value alike; with the fallback, (fallback spread / own spread)²,
+    /// so the error is measured in the skeleton's own units (see `LOSS_WEIGHT_RANGE`).
+    pub loss_weights: Option<Vec<f32>>,
 }
 
 /// Skeletal augmentation settings (see the module doc).
@@ -74,6 +78,8 @@ pub struct Augmentation {
     pub seed: u64,
     /// Which draws are normalised as an unseen skeleton (see `FallbackStats`).
     pub stats: FallbackStats,
+    /// The units a fallback-normalised draw's error is measured in (see `LossUnits`).
+    pub units: LossUnits,
 }
 
 /// Which skeletons training normalises as sampling normalises a skeleton the model never saw
@@ -97,6 +103,25 @@ pub enum FallbackStats {
     All,
 }
 
+/// The units in which the loss measures the error of a draw normalised by the fallback
+/// statistics. Why: the fallback's spreads are the zoo's average, and a creature that moves
+/// little next to it (the spider's joints move 0.39 of the average spread, its velocities
+/// 0.60) has a small signal in those units, so predicting its rest pose costs little. Under
+/// `--fallback-stats all` the bundled spider's motion energy fell from 0.91 of its clips' to
+/// 0.20 (models/zoo-compact-fallback/MODEL_CARD.md). Measuring the error in the skeleton's own
+/// units (its clips' spreads) weighs it as upstream's per-skeleton normalisation does, while
+/// the model still reads and writes the fallback's units it gets zero-shot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum LossUnits {
+    /// Every value alike, in the units it is normalised in.
+    #[default]
+    Normalised,
+    /// A fallback-normalised value's squared error times (fallback spread / own spread)²,
+    /// clamped to `LOSS_WEIGHT_RANGE`.
+    Own,
+}
+
 impl Augmentation {
     /// Upstream's odds: two of {none, remove, add} are augmentations.
     pub const DEFAULT_PROBABILITY: f64 = 2.0 / 3.0;
@@ -104,12 +129,18 @@ impl Augmentation {
 
     /// No augmentation.
     pub fn none() -> Augmentation {
-        Augmentation { probability: 0.0, variants: 0, seed: 0, stats: FallbackStats::None }
+        Augmentation { probability: 0.0, variants: 0, seed: 0, stats: FallbackStats::None, units: LossUnits::Normalised }
     }
 
     /// The defaults with `seed`.
     pub fn with_seed(seed: u64) -> Augmentation {
-        Augmentation { probability: Self::DEFAULT_PROBABILITY, variants: Self::DEFAULT_VARIANTS, seed, stats: FallbackStats::None }
+        Augmentation {
+            probability: Self::DEFAULT_PROBABILITY,
+            variants: Self::DEFAULT_VARIANTS,
+            seed,
+            stats: FallbackStats::None,
+            units: LossUnits::Normalised,
+        }
     }
 }
 
@@ -263,6 +294,7 @@ fn prepare<'a>(
         stats,
         clips: features,
         clip_names,
+        loss_weights: None,
     }))
 }
 
@@ -287,11 +319,15 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
 }
 
 /// `data` as `prepare` left it, normalised by its clips' statistics, or with `fallback`
-/// (the trained skeletons' statistics) by `condition::fallback_stats` of them.
-fn normalised(mut data: SkeletonData, fallback: Option<&[&AnyTopStats]>) -> Result<SkeletonData, DataError> {
+/// (the trained skeletons' statistics) by `condition::fallback_stats` of them, its error then
+/// measured in `units`.
+fn normalised(mut data: SkeletonData, fallback: Option<&[&AnyTopStats]>, units: LossUnits) -> Result<SkeletonData, DataError> {
     let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: data.name.clone(), why: e.to_string() };
     if let Some(trained) = fallback {
-        data.stats = crate::diffusion::condition::fallback_stats(&data.section.rest_row, trained).map_err(|e| fail(&e))?;
+        let own = std::mem::replace(&mut data.stats, crate::diffusion::condition::fallback_stats(&data.section.rest_row, trained).map_err(|e| fail(&e))?);
+        if units == LossUnits::Own {
+            data.loss_weights = Some(own_unit_weights(&own, &data.stats));
+        }
     }
     for f in &mut data.clips {
         data.stats.normalise(f).map_err(|e| fail(&e))?;
@@ -300,6 +336,17 @@ fn normalised(mut data: SkeletonData, fallback: Option<&[&AnyTopStats]>) -> Resu
     data.stats.normalise(&mut rest).map_err(|e| fail(&e))?;
     data.rest_row = rest.data;
     Ok(data)
+}
+
+/// Clamp for `own_unit_weights`: a feature that never moves (a centipede's root height) has
+/// no spread, and its weight would be unbounded.
+pub const LOSS_WEIGHT_RANGE: (f32, f32) = (1.0 / 16.0, 16.0);
+
+/// (used spread / own spread)² per value: an error in `used` units times this is the error in
+/// `own` units squared.
+fn own_unit_weights(own: &AnyTopStats, used: &AnyTopStats) -> Vec<f32> {
+    let eps = anytop::STD_EPSILON;
+    own.std.iter().zip(&used.std).map(|(o, u)| ((u + eps) / (o + eps)).powi(2).clamp(LOSS_WEIGHT_RANGE.0, LOSS_WEIGHT_RANGE.1)).collect()
 }
 
 /// The augmented variants of one skeleton (group `index` of the set): variant `v` removes
@@ -350,7 +397,7 @@ fn variants_of(
         let mut ignored = Vec::new();
         let name = format!("{}__{tag}_v{v}", base.name);
         let prepared = prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, how, &mut ignored);
-        match prepared.and_then(|data| data.map(|data| normalised(data, fallback)).transpose()) {
+        match prepared.and_then(|data| data.map(|data| normalised(data, fallback, aug.units)).transpose()) {
             Ok(Some(data)) => out.push(data),
             Ok(None) => {}
             Err(e) => skipped.push(format!("{name}: {e}")),
@@ -401,7 +448,7 @@ impl TrainSet {
         let trained: Vec<&AnyTopStats> = trained.iter().collect();
         let fallback = (aug.stats != FallbackStats::None).then_some(&trained[..]);
         for (index, group, rest, data) in prepared {
-            let data = normalised(data, fallback.filter(|_| aug.stats == FallbackStats::All))?;
+            let data = normalised(data, fallback.filter(|_| aug.stats == FallbackStats::All), aug.units)?;
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
             let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, Preparation { names, dmax }, fallback);
@@ -644,8 +691,45 @@ mod tests {
 
     /// The zoo with the default augmentation (seed 7), normalised as `stats` says.
     fn zoo_set(stats: FallbackStats) -> TrainSet {
-        let aug = Augmentation { stats, ..Augmentation::with_seed(7) };
+        zoo_set_in(stats, LossUnits::Normalised)
+    }
+
+    /// `zoo_set` with the loss measured in `units`.
+    fn zoo_set_in(stats: FallbackStats, units: LossUnits) -> TrainSet {
+        let aug = Augmentation { stats, units, ..Augmentation::with_seed(7) };
         TrainSet::build(zoo(), NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &aug).unwrap().0
+    }
+
+    #[test]
+    fn own_units_weigh_a_fallback_draws_error_by_its_own_spreads() {
+        let measured = zoo_set(FallbackStats::None);
+        let all = zoo_set_in(FallbackStats::All, LossUnits::Own);
+        let (lo, hi) = LOSS_WEIGHT_RANGE;
+        let mut clamped = 0;
+        for (a, m) in all.skeletons.iter().zip(&measured.skeletons) {
+            let w = a.loss_weights.as_ref().unwrap_or_else(|| panic!("{}: no weights", a.name));
+            assert_eq!(w.len(), m.stats.std.len(), "{}", a.name);
+            for (k, &wk) in w.iter().enumerate() {
+                let ratio = (a.stats.std[k] + anytop::STD_EPSILON) / (m.stats.std[k] + anytop::STD_EPSILON);
+                let expected = (ratio * ratio).clamp(lo, hi);
+                assert!((wk - expected).abs() <= 1e-5 * expected, "{} value {k}: {wk} vs {expected}", a.name);
+                clamped += usize::from(wk == hi || wk == lo);
+            }
+        }
+        assert!(clamped < all.skeletons.iter().map(|s| s.stats.std.len()).sum::<usize>() / 4, "the clamp is for the odd feature: {clamped}");
+        // A creature that moves less than the average spread weighs more, and one that moves more weighs less.
+        let spreads = |s: &SkeletonData| s.loss_weights.as_ref().unwrap()[anytop::FEATURE_DIMS];
+        assert!(all.skeletons.iter().any(|s| spreads(s) > 1.5) && all.skeletons.iter().any(|s| spreads(s) < 1.0));
+        // The data are those of `all` in normalised units; only the weights are new.
+        let plain = zoo_set(FallbackStats::All);
+        for (a, p) in all.skeletons.iter().zip(&plain.skeletons) {
+            assert_eq!((&a.clips[0].data, p.loss_weights.is_none()), (&p.clips[0].data, true), "{}", a.name);
+        }
+        // Under `variants`, the skeletons keep their own statistics and so need no weights.
+        let variants = zoo_set_in(FallbackStats::Variants, LossUnits::Own);
+        assert!(variants.skeletons.iter().all(|s| s.loss_weights.is_none()));
+        assert!(variants.augmented.iter().flatten().all(|v| v.loss_weights.is_some()));
+        assert!(zoo_set_in(FallbackStats::None, LossUnits::Own).augmented.iter().flatten().all(|v| v.loss_weights.is_none()));
     }
 
     #[test]

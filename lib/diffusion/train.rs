@@ -607,14 +607,32 @@ fn loss_sums(
             None => Ok(x),
         }
     };
-    let squared = weighed((&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask)?)?.sum_all()?;
+    // Values weigh by the skeleton's own units when it trains under the fallback (padding: 1).
+    let value_weights = if crops.iter().any(|c| set.data(c).loss_weights.is_some()) {
+        let mut w = vec![1f32; b * j * d];
+        for (i, c) in crops.iter().enumerate() {
+            if let Some(lw) = &set.data(c).loss_weights {
+                w[i * j * d..i * j * d + lw.len()].copy_from_slice(lw);
+            }
+        }
+        Some(Tensor::from_vec(w, (b, 1, j, d), device)?)
+    } else {
+        None
+    };
+    let weighed_values = |x: Tensor| -> candle_core::Result<Tensor> {
+        match &value_weights {
+            Some(w) => weighed(x.broadcast_mul(w)?),
+            None => weighed(x),
+        }
+    };
+    let squared = weighed_values((&predicted - &clean.x)?.sqr()?.broadcast_mul(&mask)?)?.sum_all()?;
     let values = tokens * d as f64;
     // Frame-to-frame changes of motion frames 1..t-1 (token 0 is the rest pose, never a
     // neighbour); a pair counts where both frames are real.
     let velocity = if velocity && t > 2 {
         let change = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(1, 2, t - 2)? - x.narrow(1, 1, t - 2)? };
         let pair_mask = (mask.narrow(1, 2, t - 2)? * mask.narrow(1, 1, t - 2)?)?;
-        let sum = weighed((change(&predicted)? - change(&clean.x)?)?.sqr()?.broadcast_mul(&pair_mask)?)?.sum_all()?;
+        let sum = weighed_values((change(&predicted)? - change(&clean.x)?)?.sqr()?.broadcast_mul(&pair_mask)?)?.sum_all()?;
         let count = pair_mask.sum_all()?.to_scalar::<f32>()? as f64 * d as f64;
         Some((sum, count))
     } else {
@@ -1146,6 +1164,31 @@ mod tests {
             let norm = g.sqr().unwrap().sum_all().unwrap().to_scalar::<f32>().unwrap();
             assert!(norm > 0.0 && norm.is_finite(), "{name}: gradient norm {norm}");
         }
+    }
+
+    #[test]
+    fn loss_weights_scale_each_values_error() {
+        let dev = Device::Cpu;
+        let varmap = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
+        let (mut set, schedule) = one_quadruped();
+        let loss = |set: &TrainSet, geo: f64| {
+            let terms = LossTerms { geo, vel: 0.5, weighting: Weighting::V };
+            training_loss(&model, set, &schedule, &mut SplitMix64::new(9), 3, 12, terms, &dev).unwrap().to_scalar::<f32>().unwrap() as f64
+        };
+        let (plain, plain_geo) = (loss(&set, 0.0), loss(&set, 1.0));
+        let n = set.skeletons[0].stats.std.len();
+        set.skeletons[0].loss_weights = Some(vec![3.0; n]);
+        // The MSE and velocity terms triple; the rotation term (radians) is left as it was.
+        let (tripled, tripled_geo) = (loss(&set, 0.0), loss(&set, 1.0));
+        assert!((tripled - 3.0 * plain).abs() <= 1e-4 * tripled, "{tripled} vs 3 x {plain}");
+        assert!(((tripled_geo - tripled) - (plain_geo - plain)).abs() <= 1e-4 * plain_geo, "rotation term changed");
+        // A weight on one value (joint 1's height) moves the loss up by that value's share only.
+        let mut one = vec![1.0; n];
+        one[crate::repr::anytop::FEATURE_DIMS + 1] = 2.0;
+        set.skeletons[0].loss_weights = Some(one);
+        let single = loss(&set, 0.0);
+        assert!(single > plain && single < tripled, "{single}: plain {plain}, all tripled {tripled}");
     }
 
     #[test]

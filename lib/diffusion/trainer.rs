@@ -7,7 +7,7 @@
 //! step k depends only on the seed and k (`step_rng`), and a checkpoint carries the optimiser.
 
 use super::checkpoint::{self, CheckpointInfo, TrainedRest, TrainedSkeleton};
-use super::data::{FallbackStats, TrainSet};
+use super::data::{FallbackStats, LossUnits, TrainSet};
 use super::ema::Ema;
 use super::train::{named_vars, train_step, AdamW, LossTerms, Weighting};
 use super::Schedule;
@@ -262,6 +262,8 @@ pub struct AnyTopOptions {
     pub augment_variants: usize,
     /// What is normalised by the fallback statistics (`data::FallbackStats`).
     pub fallback_stats: FallbackStats,
+    /// The units of a fallback-normalised draw's error (`data::LossUnits`).
+    pub loss_units: LossUnits,
     /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
     /// 0 = none.
     pub ema: f64,
@@ -393,6 +395,7 @@ impl AnyTopResume {
             || i.augment != opts.augment
             || i.augment_variants != opts.augment_variants
             || i.fallback_stats != opts.fallback_stats
+            || i.loss_units != opts.loss_units
             || opts.position_jitter.is_some_and(|j| j != i.position_jitter)
     }
 
@@ -449,6 +452,7 @@ impl AnyTopTrainer {
             augment: 0.0,
             augment_variants: 0,
             fallback_stats: FallbackStats::None,
+            loss_units: LossUnits::Normalised,
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
             position_jitter: base.map_or(DEFAULT_POSITION_JITTER, |b| b.position_jitter),
@@ -494,6 +498,7 @@ impl AnyTopTrainer {
         info.augment = opts.augment;
         info.augment_variants = opts.augment_variants;
         info.fallback_stats = opts.fallback_stats;
+        info.loss_units = opts.loss_units;
         info.skeletons = set
             .skeletons
             .iter()

@@ -105,8 +105,9 @@ fn augmentation_flags_and_skeleton_names_are_recorded() {
     }
 }
 
-/// --fallback-stats is recorded only when it is not none, upstream's way (old checkpoints read as
-/// none), a resume keeps it unless told otherwise, and SATA refuses it.
+/// --fallback-stats and --loss-units are recorded only when they are not the defaults (upstream's
+/// way; old checkpoints read as those), a resume keeps them unless told otherwise, SATA refuses
+/// them, and own units without a fallback (they would weigh nothing) are refused.
 #[test]
 fn fallback_stats_are_recorded_and_kept_by_resume() {
     let dir = tempdir("train-fallback-stats");
@@ -114,22 +115,32 @@ fn fallback_stats_are_recorded_and_kept_by_resume() {
     let (plain, fallback) = (dir.join("plain"), dir.join("fallback"));
     ok(&run("mo-train", &train_args(&data, &plain, "1"), None), "measured");
     assert!(info(&plain).get("fallback_stats").is_none(), "measured is the default and not written");
+    assert!(info(&plain).get("loss_units").is_none(), "normalised is the default and not written");
     let mut args = train_args(&data, &fallback, "1");
-    args.extend(["--fallback-stats", "variants"]);
+    args.extend(["--fallback-stats", "variants", "--loss-units", "own"]);
     ok(&run("mo-train", &args, None), "fallback");
-    assert_eq!(info(&fallback)["fallback_stats"], "variants");
+    assert_eq!((info(&fallback)["fallback_stats"].as_str(), info(&fallback)["loss_units"].as_str()), (Some("variants"), Some("own")));
     let mut args = train_args(&data, &fallback, "2");
     args.push("--resume");
     let resumed = run("mo-train", &args, None);
     ok(&resumed, "resume");
     assert!(!String::from_utf8_lossy(&resumed.stderr).contains("differ from the checkpoint"), "the same run goes on");
-    assert_eq!((info(&fallback)["step"].as_u64(), info(&fallback)["fallback_stats"].as_str()), (Some(2), Some("variants")));
+    let kept = info(&fallback);
+    assert_eq!((kept["step"].as_u64(), kept["fallback_stats"].as_str(), kept["loss_units"].as_str()), (Some(2), Some("variants"), Some("own")));
     let sata = dir.join("sata");
-    let mut args = train_args(&data, &sata, "1");
-    args.extend(["--arch", "sata", "--fallback-stats", "variants"]);
+    for flag in ["--fallback-stats", "--loss-units"] {
+        let mut args = train_args(&data, &sata, "1");
+        args.extend(["--arch", "sata", flag, if flag == "--loss-units" { "own" } else { "variants" }]);
+        let out = run("mo-train", &args, None);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.code() == Some(2) && stderr.contains(flag) && !sata.exists(), "{stderr}");
+    }
+    let alone = dir.join("alone");
+    let mut args = train_args(&data, &alone, "1");
+    args.extend(["--loss-units", "own"]);
     let out = run("mo-train", &args, None);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.code() == Some(2) && stderr.contains("--fallback-stats") && !sata.exists(), "{stderr}");
+    assert!(out.status.code() == Some(2) && stderr.contains("--fallback-stats") && !alone.exists(), "{stderr}");
 }
 
 /// A learning rate that blows the model up: the first non-finite loss stops training with exit
