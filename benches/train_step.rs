@@ -133,6 +133,7 @@ fn main() {
         augment_variants: 0,
         fallback_stats: Default::default(),
         loss_units: Default::default(),
+        rest_token: Default::default(),
     };
     let dev = Device::Cpu;
     let scratch = std::env::temp_dir().join(format!("menagerie-train-bench-{}", std::process::id()));

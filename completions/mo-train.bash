@@ -23,7 +23,7 @@ _mo__train() {
 
     case "${cmd}" in
         mo__train)
-            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --augment --augment-variants --fallback-stats --loss-units --ema --noise-shift --loss-weighting --position-jitter --shift-taper --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --animation --fps --help --version"
+            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --augment --augment-variants --fallback-stats --loss-units --rest-token --ema --noise-shift --loss-weighting --position-jitter --shift-taper --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -95,6 +95,10 @@ _mo__train() {
                     ;;
                 --loss-units)
                     COMPREPLY=($(compgen -W "normalised own" -- "${cur}"))
+                    return 0
+                    ;;
+                --rest-token)
+                    COMPREPLY=($(compgen -W "skeleton global" -- "${cur}"))
                     return 0
                     ;;
                 --ema)

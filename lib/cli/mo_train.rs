@@ -4,6 +4,7 @@ use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, FallbackStats, LossUnits, TrainSet};
+use crate::diffusion::rest_norm::{RestNorm, RestToken};
 use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::embed::NameTable;
 use crate::nn::{DenoiserConfig, Preset};
@@ -150,6 +151,13 @@ pub struct Args {
     /// checkpoint's]
     #[arg(long, value_name = "UNITS", value_enum)]
     pub loss_units: Option<LossUnits>,
+    /// anytop: what the rest-pose token is normalised by: `skeleton` (its skeleton's statistics,
+    /// as the motion: all zeros under the fallback, so the model never learns where a creature's
+    /// legs point) or `global` (statistics pooled over the training skeletons' rest poses, kept
+    /// in the checkpoint, the same for every skeleton) [default: skeleton; with --resume the
+    /// checkpoint's; with --init the model's]
+    #[arg(long, value_name = "HOW", value_enum)]
+    pub rest_token: Option<RestToken>,
     /// anytop: decay of the moving average of the weights that the saved model holds and
     /// mo-sample samples with (the raw weights are kept beside it for --resume). 0 = save the
     /// raw weights. An average over about 1/(1 - decay) steps.
@@ -266,6 +274,8 @@ struct Previous {
     fallback_stats: FallbackStats,
     #[serde(default)]
     loss_units: LossUnits,
+    #[serde(default)]
+    rest_norm: Option<RestNorm>,
 }
 
 impl Previous {
@@ -283,6 +293,9 @@ struct Resolved {
     augment: f64,
     fallback_stats: FallbackStats,
     loss_units: LossUnits,
+    rest_token: RestToken,
+    /// The pooled rest statistics a resumed run keeps.
+    rest_norm: Option<RestNorm>,
     steps: u64,
     batch: u64,
     /// `None`: the architecture's own (sata: the preset's window).
@@ -299,6 +312,11 @@ impl Resolved {
             augment: pick(args.augment, previous.as_ref().map(|p| p.augment), 0.0, 2.0 / 3.0),
             fallback_stats: args.fallback_stats.or(previous.as_ref().map(|p| p.fallback_stats)).unwrap_or_default(),
             loss_units: args.loss_units.or(previous.as_ref().map(|p| p.loss_units)).unwrap_or_default(),
+            rest_token: args
+                .rest_token
+                .or(previous.as_ref().map(|p| if p.rest_norm.is_some() { RestToken::Global } else { RestToken::Skeleton }))
+                .unwrap_or_default(),
+            rest_norm: previous.as_ref().and_then(|p| p.rest_norm),
             steps: args.steps.unwrap_or(if args.minutes.is_some() { bounds::MAX_TRAIN_STEPS } else { 10_000 }),
             batch: args.batch.or(previous.as_ref().map(|p| p.batch)).unwrap_or(if fine_tune { INIT_BATCH } else { 16 }),
             crop: args.crop.or(previous.as_ref().and_then(|p| p.crop)).or(fine_tune.then_some(INIT_CROP)),
@@ -316,6 +334,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if args.fallback_stats.is_some() && args.arch != Arch::Anytop {
         bail!("--fallback-stats is the diffusion model's (--arch anytop); --arch sata normalises every skeleton by its clips");
+    }
+    if args.rest_token.is_some() && args.arch != Arch::Anytop {
+        bail!("--rest-token is the diffusion model's (--arch anytop)");
     }
     if args.loss_units.is_some() && args.arch != Arch::Anytop {
         bail!("--loss-units is the diffusion model's (--arch anytop); --arch sata normalises every skeleton by its clips");
@@ -353,6 +374,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         augment_variants: args.augment_variants as usize,
         fallback_stats: resolved.fallback_stats,
         loss_units: resolved.loss_units,
+        rest_token: resolved.rest_token,
         ema: args.ema,
         noise_shift: args.noise_shift,
         position_jitter: args.position_jitter.map(|n| n as usize),
@@ -366,7 +388,18 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
     let (start, notes) = AnyTopStart::choose(&args.out, args.resume, args.init.as_deref(), resolved.lr, &opts, device)?;
     notes.iter().for_each(|note| say(args, note));
     let seed = start.seed(&opts);
-    let set = training_set(args, resolved, seed, start.dmax())?;
+    // A fine-tune reads rest tokens as its model learned to.
+    let rest = match start.init_rest_norm() {
+        Some(norm) => {
+            let token = if norm.is_some() { RestToken::Global } else { RestToken::Skeleton };
+            if args.rest_token.is_some_and(|t| t != token) {
+                bail!("--rest-token: the model given to --init normalises rest tokens the other way ({token:?}); a fine-tune keeps its model's");
+            }
+            (token, norm)
+        }
+        None => (resolved.rest_token, resolved.rest_norm),
+    };
+    let set = training_set(args, resolved, seed, start.dmax(), rest)?;
     let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, device).map_err(explain)?;
     train(args, resolved, trainer.first_step(), &mut trainer)
 }
@@ -396,7 +429,7 @@ fn train_sata(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Resu
         opts.config.validate()?;
     }
     let seed = resume.as_ref().map_or(opts.seed, |r| r.info().seed);
-    let set = training_set(args, resolved, seed, topology::DEFAULT_DMAX)?;
+    let set = training_set(args, resolved, seed, topology::DEFAULT_DMAX, (RestToken::Skeleton, None))?;
     let mut trainer = SataTrainer::new(&args.out, &opts, resume, set, device).map_err(explain)?;
     train(args, resolved, trainer.first_step(), &mut trainer)
 }
@@ -455,7 +488,7 @@ fn train(args: &Args, resolved: &Resolved, first: u64, trainer: &mut impl Traine
 }
 
 /// The clips of DATA grouped by skeleton, with augmented variants, as both architectures use.
-fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> anyhow::Result<TrainSet> {
+fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize, rest: (RestToken, Option<RestNorm>)) -> anyhow::Result<TrainSet> {
     let clips = load_motions(&expand_inputs(&args.data)?, &LoadOptions::default())?;
     let names = NameTable::builtin().context("the built-in joint-name table")?;
     let augmentation = Augmentation {
@@ -464,6 +497,8 @@ fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize) -> any
         seed,
         stats: resolved.fallback_stats,
         units: resolved.loss_units,
+        rest_token: rest.0,
+        rest_norm: rest.1.filter(|_| rest.0 == RestToken::Global),
     };
     let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;
     set.report(&dropped, args.common.verbose).iter().for_each(|line| say(args, line));

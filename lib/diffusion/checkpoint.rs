@@ -183,6 +183,11 @@ pub struct CheckpointInfo {
     /// checkpoints written before the choice).
     #[serde(default, skip_serializing_if = "is_normalised_units")]
     pub loss_units: crate::diffusion::data::LossUnits,
+    /// What the rest tokens were normalised by, when not each skeleton's statistics
+    /// (`rest_norm`; absent in checkpoints written before the choice). Sampling normalises a
+    /// skeleton's rest token by it too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest_norm: Option<crate::diffusion::rest_norm::RestNorm>,
     /// Decay of the weights' moving average that `model.safetensors` holds (`ema.rs`); 0 = the
     /// raw weights (and checkpoints written before the average existed).
     #[serde(default)]

@@ -57,7 +57,12 @@ impl SkeletonCondition {
         stats_source: StatsSource,
     ) -> Result<SkeletonCondition, DiffusionError> {
         let mut rest = Features { frames: 1, joints: skeleton.len(), dims: FEATURE_DIMS, data: rest_row.concat() };
-        stats.normalise(&mut rest).map_err(|source| DiffusionError::Stats { what: "normalising the rest pose", source })?;
+        // As training normalised the rest tokens (`rest_norm`).
+        match &info.rest_norm {
+            Some(norm) => norm.for_joints(skeleton.len()).normalise(&mut rest),
+            None => stats.normalise(&mut rest),
+        }
+        .map_err(|source| DiffusionError::Stats { what: "normalising the rest pose", source })?;
         let names = NameTable::builtin().map_err(DiffusionError::Names)?.embed_skeleton(skeleton);
         Ok(SkeletonCondition {
             rest_row: rest.data,
@@ -95,4 +100,37 @@ pub fn fallback_stats(rest_row: &[Vec<f32>], trained: &[&AnyTopStats]) -> Result
     let mean: Vec<f32> = rest_row.concat();
     let std: Vec<f32> = (0..rest_row.len()).flat_map(|j| if j == 0 { root.clone() } else { joint.clone() }).collect();
     Ok(AnyTopStats { mean, std })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diffusion::rest_norm::RestNorm;
+
+    /// Sampling normalises the rest token as training did: by the checkpoint's pooled rest
+    /// statistics when it has them, by the skeleton's statistics (all zeros under the fallback)
+    /// when not.
+    #[test]
+    fn the_rest_token_is_normalised_as_the_checkpoint_says() {
+        let mut info: CheckpointInfo = serde_json::from_slice(crate::diffusion::checkpoint::BUILTIN_INFO).unwrap();
+        let (mut skeleton, _) = crate::synth::creature("spider", 3).unwrap();
+        // Names no trained skeleton has: a skeleton the model never saw.
+        skeleton.joints.iter_mut().enumerate().for_each(|(i, j)| j.name = format!("part{i}"));
+        let rest_row: Vec<Vec<f32>> = (0..skeleton.len()).map(|j| (0..FEATURE_DIMS).map(|k| (j * FEATURE_DIMS + k) as f32 * 0.01).collect()).collect();
+        let skeleton_way = SkeletonCondition::new(&info, &skeleton, &rest_row).unwrap();
+        assert_eq!(skeleton_way.stats_source, StatsSource::Fallback);
+        assert!(skeleton_way.rest_row.iter().all(|&x| x == 0.0), "the fallback's mean is the rest pose");
+        let norm = RestNorm { mean: [[0.1; FEATURE_DIMS], [0.2; FEATURE_DIMS]], std: [[0.5; FEATURE_DIMS], [2.0; FEATURE_DIMS]] };
+        info.rest_norm = Some(norm);
+        let global = SkeletonCondition::new(&info, &skeleton, &rest_row).unwrap();
+        let expected: Vec<f32> = rest_row
+            .iter()
+            .enumerate()
+            .flat_map(|(j, row)| row.iter().map(move |&x| if j == 0 { (x - 0.1) / (0.5 + 1e-6) } else { (x - 0.2) / (2.0 + 1e-6) }))
+            .collect();
+        assert_eq!(global.rest_row.len(), expected.len());
+        assert!(global.rest_row.iter().zip(&expected).all(|(a, b)| (a - b).abs() < 1e-5));
+        // The motion's statistics are the same either way.
+        assert_eq!(global.stats, skeleton_way.stats);
+    }
 }

@@ -23,6 +23,7 @@
 //! variants (each clip is re-encoded for one variant only), so augmentation at most about
 //! doubles the feature memory.
 
+use super::rest_norm::{RestNorm, RestToken};
 use crate::augment::{self, RemoveAmount};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
@@ -80,6 +81,11 @@ pub struct Augmentation {
     pub stats: FallbackStats,
     /// The units a fallback-normalised draw's error is measured in (see `LossUnits`).
     pub units: LossUnits,
+    /// What the rest token is normalised by (`rest_norm::RestToken`); under `Global`, the
+    /// pooled statistics to use (a resumed or fine-tuned model's), or `None` to pool them from
+    /// the skeletons.
+    pub rest_token: RestToken,
+    pub rest_norm: Option<RestNorm>,
 }
 
 /// Which skeletons training normalises as sampling normalises a skeleton the model never saw
@@ -129,18 +135,20 @@ impl Augmentation {
 
     /// No augmentation.
     pub fn none() -> Augmentation {
-        Augmentation { probability: 0.0, variants: 0, seed: 0, stats: FallbackStats::None, units: LossUnits::Normalised }
+        Augmentation {
+            probability: 0.0,
+            variants: 0,
+            seed: 0,
+            stats: FallbackStats::None,
+            units: LossUnits::Normalised,
+            rest_token: RestToken::Skeleton,
+            rest_norm: None,
+        }
     }
 
     /// The defaults with `seed`.
     pub fn with_seed(seed: u64) -> Augmentation {
-        Augmentation {
-            probability: Self::DEFAULT_PROBABILITY,
-            variants: Self::DEFAULT_VARIANTS,
-            seed,
-            stats: FallbackStats::None,
-            units: LossUnits::Normalised,
-        }
+        Augmentation { probability: Self::DEFAULT_PROBABILITY, variants: Self::DEFAULT_VARIANTS, seed, ..Self::none() }
     }
 }
 
@@ -156,6 +164,8 @@ pub struct TrainSet {
     /// A crop's temporal positions start at a random offset in `0..=position_jitter` (0: every
     /// crop starts at 0), drawn apart from where the crop lies in its clip; see `Crop::position`.
     pub position_jitter: usize,
+    /// What every rest token was normalised by, when not its skeleton's statistics.
+    pub rest_norm: Option<RestNorm>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -318,12 +328,24 @@ fn deal(frames: &[usize], v: usize, variants: usize) -> Vec<(usize, std::ops::Ra
     vec![(clip, start..start + size)]
 }
 
-/// `data` as `prepare` left it, normalised by its clips' statistics, or with `fallback`
+/// How `normalised` normalises a skeleton.
+#[derive(Clone, Copy)]
+struct Norms<'a> {
+    /// The trained skeletons' statistics, when the skeleton is normalised by the fallback.
+    fallback: Option<&'a [&'a AnyTopStats]>,
+    /// The units of a fallback-normalised skeleton's error.
+    units: LossUnits,
+    /// What the rest token is normalised by, when not as the motion.
+    rest: Option<&'a RestNorm>,
+}
+
+/// `data` as `prepare` left it, normalised by its clips' statistics, or with `how.fallback`
 /// (the trained skeletons' statistics) by `condition::fallback_stats` of them, its error then
-/// measured in `units`.
-fn normalised(mut data: SkeletonData, fallback: Option<&[&AnyTopStats]>, units: LossUnits) -> Result<SkeletonData, DataError> {
+/// measured in `how.units`; its rest token by `how.rest` when given, else as the motion.
+fn normalised(mut data: SkeletonData, how: Norms) -> Result<SkeletonData, DataError> {
     let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: data.name.clone(), why: e.to_string() };
-    if let Some(trained) = fallback {
+    let (units, rest_norm) = (how.units, how.rest);
+    if let Some(trained) = how.fallback {
         let own = std::mem::replace(&mut data.stats, crate::diffusion::condition::fallback_stats(&data.section.rest_row, trained).map_err(|e| fail(&e))?);
         if units == LossUnits::Own {
             data.loss_weights = Some(own_unit_weights(&own, &data.stats));
@@ -333,7 +355,11 @@ fn normalised(mut data: SkeletonData, fallback: Option<&[&AnyTopStats]>, units: 
         data.stats.normalise(f).map_err(|e| fail(&e))?;
     }
     let mut rest = Features { frames: 1, joints: data.skeleton.len(), dims: anytop::FEATURE_DIMS, data: std::mem::take(&mut data.rest_row) };
-    data.stats.normalise(&mut rest).map_err(|e| fail(&e))?;
+    match rest_norm {
+        Some(norm) => norm.for_joints(data.skeleton.len()).normalise(&mut rest),
+        None => data.stats.normalise(&mut rest),
+    }
+    .map_err(|e| fail(&e))?;
     data.rest_row = rest.data;
     Ok(data)
 }
@@ -353,7 +379,7 @@ fn own_unit_weights(own: &AnyTopStats, used: &AnyTopStats) -> Vec<f32> {
 /// joints (`v` even) or subdivides one bone (`v` odd) and carries the frames `deal` gives it.
 /// Variants whose edit changes nothing, or whose clips are all too short, are left out; so are
 /// variants that cannot be prepared (returned with the reason): an augmentation is never
-/// worth failing a training run for.
+/// worth failing a training run for. Each is normalised as `norms` says (the fallback, when given, always: a variant is a new topology).
 fn variants_of(
     index: usize,
     base: &SkeletonData,
@@ -361,7 +387,7 @@ fn variants_of(
     rest: &Clip,
     aug: &Augmentation,
     how: Preparation,
-    fallback: Option<&[&AnyTopStats]>,
+    norms: Norms,
 ) -> (Vec<SkeletonData>, Vec<String>) {
     let (mut out, mut skipped) = (Vec::new(), Vec::new());
     for v in 0..aug.variants {
@@ -397,7 +423,7 @@ fn variants_of(
         let mut ignored = Vec::new();
         let name = format!("{}__{tag}_v{v}", base.name);
         let prepared = prepare(name.clone(), plan.skeleton.clone(), (&rest.name, &rest_motion), clips, how, &mut ignored);
-        match prepared.and_then(|data| data.map(|data| normalised(data, fallback, aug.units)).transpose()) {
+        match prepared.and_then(|data| data.map(|data| normalised(data, norms)).transpose()) {
             Ok(Some(data)) => out.push(data),
             Ok(None) => {}
             Err(e) => skipped.push(format!("{name}: {e}")),
@@ -447,11 +473,20 @@ impl TrainSet {
         let trained: Vec<AnyTopStats> = prepared.iter().map(|(_, _, _, d)| d.stats.clone()).collect();
         let trained: Vec<&AnyTopStats> = trained.iter().collect();
         let fallback = (aug.stats != FallbackStats::None).then_some(&trained[..]);
+        let rest_norm = match aug.rest_token {
+            RestToken::Skeleton => None,
+            RestToken::Global => Some(
+                aug.rest_norm
+                    .or_else(|| RestNorm::pool(prepared.iter().map(|(_, _, _, d)| d.rest_row.as_slice())))
+                    .ok_or_else(|| DataError::Clip { clip: "--rest-token global".into(), why: "no skeleton has a joint besides its root".into() })?,
+            ),
+        };
         for (index, group, rest, data) in prepared {
-            let data = normalised(data, fallback.filter(|_| aug.stats == FallbackStats::All), aug.units)?;
+            let norms = Norms { fallback, units: aug.units, rest: rest_norm.as_ref() };
+            let data = normalised(data, Norms { fallback: fallback.filter(|_| aug.stats == FallbackStats::All), ..norms })?;
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
-            let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, Preparation { names, dmax }, fallback);
+            let (variants, skipped) = variants_of(index, &data, &group, &group[rest], &wanted, Preparation { names, dmax }, norms);
             augmented.push(variants);
             skipped_variants.extend(skipped);
             skeletons.push(data);
@@ -459,7 +494,7 @@ impl TrainSet {
         if skeletons.is_empty() {
             return Err(DataError::TooShort { clip: first_short.unwrap_or_default() });
         }
-        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants, position_jitter: 0 }, dropped))
+        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants, position_jitter: 0, rest_norm }, dropped))
     }
 
     /// The skeleton (original or augmented variant) a crop comes from.
@@ -698,6 +733,35 @@ mod tests {
     fn zoo_set_in(stats: FallbackStats, units: LossUnits) -> TrainSet {
         let aug = Augmentation { stats, units, ..Augmentation::with_seed(7) };
         TrainSet::build(zoo(), NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, &aug).unwrap().0
+    }
+
+    #[test]
+    fn a_global_rest_token_carries_every_skeletons_shape_under_the_fallback() {
+        let aug = |rest_token, rest_norm| Augmentation { stats: FallbackStats::All, rest_token, rest_norm, ..Augmentation::with_seed(7) };
+        let build = |a: &Augmentation| TrainSet::build(zoo(), NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, a).unwrap().0;
+        let zeros = build(&aug(RestToken::Skeleton, None));
+        assert!(zeros.rest_norm.is_none());
+        assert!(zeros.skeletons.iter().all(|s| s.rest_row.iter().all(|&x| x == 0.0)), "the fallback's mean is the rest pose");
+        let global = build(&aug(RestToken::Global, None));
+        let norm = global.rest_norm.expect("pooled");
+        let raw: Vec<Vec<f32>> = global.skeletons.iter().map(|s| s.section.rest_row.concat()).collect();
+        assert_eq!(Some(norm), RestNorm::pool(raw.iter().map(|r| r.as_slice())), "pooled over the skeletons' rest rows");
+        for (s, raw) in global.skeletons.iter().chain(global.augmented.iter().flatten()).zip(raw.iter().chain(std::iter::repeat(&Vec::new()))) {
+            let mut expected = Features { frames: 1, joints: s.skeleton.len(), dims: anytop::FEATURE_DIMS, data: s.section.rest_row.concat() };
+            norm.for_joints(s.skeleton.len()).normalise(&mut expected).unwrap();
+            assert_eq!(s.rest_row, expected.data, "{}", s.name);
+            assert!(raw.is_empty() || s.rest_row.iter().any(|&x| x.abs() > 0.5), "{}: a shape, not zeros", s.name);
+        }
+        // The motion is normalised as before; only the rest token changes.
+        for (a, b) in global.skeletons.iter().zip(&zeros.skeletons) {
+            assert_eq!((&a.stats, &a.clips[0].data), (&b.stats, &b.clips[0].data), "{}", a.name);
+        }
+        // Given statistics (a resumed model's) are used as they are, not pooled again.
+        let mut other = norm;
+        other.mean[1][0] += 1.0;
+        let given = build(&aug(RestToken::Global, Some(other)));
+        assert_eq!(given.rest_norm, Some(other));
+        assert_ne!(given.skeletons[0].rest_row, global.skeletons[0].rest_row);
     }
 
     #[test]

@@ -8,6 +8,7 @@ pub mod edit;
 pub mod ema;
 pub mod keep;
 pub mod progress;
+pub mod rest_norm;
 pub mod sample;
 pub mod schedule;
 pub mod start;

@@ -9,6 +9,7 @@
 use super::checkpoint::{self, CheckpointInfo, TrainedRest, TrainedSkeleton};
 use super::data::{FallbackStats, LossUnits, TrainSet};
 use super::ema::Ema;
+use super::rest_norm::RestToken;
 use super::train::{named_vars, train_step, AdamW, LossTerms, Weighting};
 use super::Schedule;
 use crate::nn::{seeded_var_builder, Denoiser, DenoiserConfig, NnError};
@@ -264,6 +265,8 @@ pub struct AnyTopOptions {
     pub fallback_stats: FallbackStats,
     /// The units of a fallback-normalised draw's error (`data::LossUnits`).
     pub loss_units: LossUnits,
+    /// What the rest tokens are normalised by (`rest_norm::RestToken`).
+    pub rest_token: RestToken,
     /// Decay of the weights' moving average that checkpoints hold for sampling (`ema.rs`);
     /// 0 = none.
     pub ema: f64,
@@ -322,6 +325,15 @@ pub enum AnyTopStart {
 impl AnyTopStart {
     /// The topology distance limit the training set must be built with: the starting
     /// model's, or the default for new weights.
+    /// A fine-tune's model's pooled rest statistics (`Some(None)`: it normalises rest tokens by
+    /// each skeleton's); `None` for other starts.
+    pub fn init_rest_norm(&self) -> Option<Option<crate::diffusion::rest_norm::RestNorm>> {
+        match self {
+            AnyTopStart::Init(i) => Some(i.loaded.info.rest_norm),
+            _ => None,
+        }
+    }
+
     pub fn dmax(&self) -> usize {
         match self {
             AnyTopStart::New => crate::skeleton::topology::DEFAULT_DMAX,
@@ -396,6 +408,7 @@ impl AnyTopResume {
             || i.augment_variants != opts.augment_variants
             || i.fallback_stats != opts.fallback_stats
             || i.loss_units != opts.loss_units
+            || i.rest_norm.is_some() != (opts.rest_token == RestToken::Global)
             || opts.position_jitter.is_some_and(|j| j != i.position_jitter)
     }
 
@@ -453,6 +466,7 @@ impl AnyTopTrainer {
             augment_variants: 0,
             fallback_stats: FallbackStats::None,
             loss_units: LossUnits::Normalised,
+            rest_norm: None,
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
             position_jitter: base.map_or(DEFAULT_POSITION_JITTER, |b| b.position_jitter),
@@ -499,6 +513,7 @@ impl AnyTopTrainer {
         info.augment_variants = opts.augment_variants;
         info.fallback_stats = opts.fallback_stats;
         info.loss_units = opts.loss_units;
+        info.rest_norm = set.rest_norm;
         info.skeletons = set
             .skeletons
             .iter()

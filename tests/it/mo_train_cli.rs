@@ -143,6 +143,42 @@ fn fallback_stats_are_recorded_and_kept_by_resume() {
     assert!(out.status.code() == Some(2) && stderr.contains("--fallback-stats") && !alone.exists(), "{stderr}");
 }
 
+/// --rest-token global: the pooled rest statistics are recorded, a resume keeps them, a fine-tune
+/// inherits them (and refuses to read rest tokens the other way), and the model samples.
+#[test]
+fn a_global_rest_token_is_recorded_kept_and_inherited() {
+    let dir = tempdir("train-rest-token");
+    let data = data(&dir);
+    let run_dir = dir.join("global");
+    let mut args = train_args(&data, &run_dir, "1");
+    args.extend(["--fallback-stats", "all", "--rest-token", "global"]);
+    ok(&run("mo-train", &args, None), "global");
+    let norm = info(&run_dir)["rest_norm"].clone();
+    assert_eq!((norm["mean"].as_array().map(Vec::len), norm["std"][1].as_array().map(Vec::len)), (Some(2), Some(13)), "{norm}");
+    let mut args = train_args(&data, &run_dir, "2");
+    args.push("--resume");
+    let resumed = run("mo-train", &args, None);
+    ok(&resumed, "resume");
+    assert!(!String::from_utf8_lossy(&resumed.stderr).contains("differ from the checkpoint"), "the same run goes on");
+    assert_eq!((info(&run_dir)["step"].as_u64(), &info(&run_dir)["rest_norm"]), (Some(2), &norm));
+    let tuned = dir.join("tuned");
+    let mut args = vec![s(&data[0]), "--init", s(&run_dir), "--out", s(&tuned), "--steps", "1", "--crop", "12"];
+    ok(&run("mo-train", &args, None), "fine-tune");
+    assert_eq!(info(&tuned)["rest_norm"], norm, "a fine-tune reads rest tokens as its model learned to");
+    let refused = dir.join("refused");
+    args[3] = s(&refused);
+    args.extend(["--rest-token", "skeleton"]);
+    let out = run("mo-train", &args, None);
+    assert!(out.status.code() == Some(2) && !refused.exists(), "{}", String::from_utf8_lossy(&out.stderr));
+    let walk = data[0].join("biped_walk.bvh");
+    let sampled = run("mo-sample", &[s(&walk), "--model", s(&tuned), "-n", "1", "--frames", "8", "--steps", "2", "-q"], None);
+    ok(&sampled, "sample");
+    assert!(sampled.stdout.starts_with(b"\x93NUMPY"), "an NPY on stdout");
+    let plain = dir.join("plain");
+    ok(&run("mo-train", &train_args(&data, &plain, "1"), None), "plain");
+    assert!(info(&plain).get("rest_norm").is_none(), "skeleton is the default and not written");
+}
+
 /// A learning rate that blows the model up: the first non-finite loss stops training with exit
 /// 2, the checkpoint stays the last good one, and every log line is JSON.
 #[test]
