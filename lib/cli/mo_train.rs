@@ -147,8 +147,8 @@ pub struct Args {
     pub fallback_stats: Option<FallbackStats>,
     /// anytop: the units of the error of what --fallback-stats normalises: `own` measures it in
     /// the skeleton's own clips' spreads, so a creature that moves little next to the average
-    /// spread weighs as much as one that moves a lot [default: normalised; with --resume the
-    /// checkpoint's]
+    /// spread weighs as much as one that moves a lot (measured on the zoo: no better than
+    /// `normalised`) [default: normalised; with --resume the checkpoint's]
     #[arg(long, value_name = "UNITS", value_enum)]
     pub loss_units: Option<LossUnits>,
     /// anytop: what the rest-pose token is normalised by: `skeleton` (its skeleton's statistics,

@@ -24,7 +24,7 @@ impl AnyTopStart {
             let resume = AnyTopResume::load(out, lr, device)?;
             if resume.differs(opts) {
                 notes.push(
-                    "note: --batch, --crop, --seed, --position-jitter, --augment*, --fallback-stats or --loss-units differ from the checkpoint's; the resumed run is not the one it would have been".to_string(),
+                    "note: --batch, --crop, --seed, --position-jitter, --augment*, --fallback-stats, --loss-units or --rest-token differ from the checkpoint's; the resumed run is not the one it would have been".to_string(),
                 );
             }
             if let Some((old, new)) = resume.shift_changes(opts) {
