@@ -4,7 +4,7 @@ use crate::cli::bounds;
 use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, FallbackStats, LossUnits, TrainSet};
-use crate::diffusion::rest_norm::{RestNorm, RestToken};
+use crate::diffusion::rest_norm::{RestNorm, RestToken, RestTokens};
 use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::embed::NameTable;
 use crate::nn::{DenoiserConfig, Preset};
@@ -293,9 +293,8 @@ struct Resolved {
     augment: f64,
     fallback_stats: FallbackStats,
     loss_units: LossUnits,
-    rest_token: RestToken,
-    /// The pooled rest statistics a resumed run keeps.
-    rest_norm: Option<RestNorm>,
+    /// A resumed run keeps its pooled rest statistics.
+    rest: RestTokens,
     steps: u64,
     batch: u64,
     /// `None`: the architecture's own (sata: the preset's window).
@@ -312,11 +311,11 @@ impl Resolved {
             augment: pick(args.augment, previous.as_ref().map(|p| p.augment), 0.0, 2.0 / 3.0),
             fallback_stats: args.fallback_stats.or(previous.as_ref().map(|p| p.fallback_stats)).unwrap_or_default(),
             loss_units: args.loss_units.or(previous.as_ref().map(|p| p.loss_units)).unwrap_or_default(),
-            rest_token: args
-                .rest_token
-                .or(previous.as_ref().map(|p| if p.rest_norm.is_some() { RestToken::Global } else { RestToken::Skeleton }))
-                .unwrap_or_default(),
-            rest_norm: previous.as_ref().and_then(|p| p.rest_norm),
+            rest: {
+                let known = previous.as_ref().and_then(|p| p.rest_norm);
+                let kept = if known.is_some() { RestToken::Global } else { RestToken::Skeleton };
+                RestTokens::of(args.rest_token.unwrap_or(kept), known)
+            },
             steps: args.steps.unwrap_or(if args.minutes.is_some() { bounds::MAX_TRAIN_STEPS } else { 10_000 }),
             batch: args.batch.or(previous.as_ref().map(|p| p.batch)).unwrap_or(if fine_tune { INIT_BATCH } else { 16 }),
             crop: args.crop.or(previous.as_ref().and_then(|p| p.crop)).or(fine_tune.then_some(INIT_CROP)),
@@ -374,7 +373,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         augment_variants: args.augment_variants as usize,
         fallback_stats: resolved.fallback_stats,
         loss_units: resolved.loss_units,
-        rest_token: resolved.rest_token,
+        rest_token: resolved.rest.token(),
         ema: args.ema,
         noise_shift: args.noise_shift,
         position_jitter: args.position_jitter.map(|n| n as usize),
@@ -391,13 +390,13 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
     // A fine-tune reads rest tokens as its model learned to.
     let rest = match start.init_rest_norm() {
         Some(norm) => {
-            let token = if norm.is_some() { RestToken::Global } else { RestToken::Skeleton };
-            if args.rest_token.is_some_and(|t| t != token) {
-                bail!("--rest-token: the model given to --init normalises rest tokens the other way ({token:?}); a fine-tune keeps its model's");
+            let rest = norm.map_or(RestTokens::Skeleton, RestTokens::Given);
+            if args.rest_token.is_some_and(|t| t != rest.token()) {
+                bail!("--rest-token: the model given to --init normalises rest tokens the other way ({:?}); a fine-tune keeps its model's", rest.token());
             }
-            (token, norm)
+            rest
         }
-        None => (resolved.rest_token, resolved.rest_norm),
+        None => resolved.rest,
     };
     let set = training_set(args, resolved, seed, start.dmax(), rest)?;
     let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, device).map_err(explain)?;
@@ -429,7 +428,7 @@ fn train_sata(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Resu
         opts.config.validate()?;
     }
     let seed = resume.as_ref().map_or(opts.seed, |r| r.info().seed);
-    let set = training_set(args, resolved, seed, topology::DEFAULT_DMAX, (RestToken::Skeleton, None))?;
+    let set = training_set(args, resolved, seed, topology::DEFAULT_DMAX, RestTokens::Skeleton)?;
     let mut trainer = SataTrainer::new(&args.out, &opts, resume, set, device).map_err(explain)?;
     train(args, resolved, trainer.first_step(), &mut trainer)
 }
@@ -488,7 +487,7 @@ fn train(args: &Args, resolved: &Resolved, first: u64, trainer: &mut impl Traine
 }
 
 /// The clips of DATA grouped by skeleton, with augmented variants, as both architectures use.
-fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize, rest: (RestToken, Option<RestNorm>)) -> anyhow::Result<TrainSet> {
+fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize, rest: RestTokens) -> anyhow::Result<TrainSet> {
     let clips = load_motions(&expand_inputs(&args.data)?, &LoadOptions::default())?;
     let names = NameTable::builtin().context("the built-in joint-name table")?;
     let augmentation = Augmentation {
@@ -497,8 +496,7 @@ fn training_set(args: &Args, resolved: &Resolved, seed: u64, dmax: usize, rest: 
         seed,
         stats: resolved.fallback_stats,
         units: resolved.loss_units,
-        rest_token: rest.0,
-        rest_norm: rest.1.filter(|_| rest.0 == RestToken::Global),
+        rest,
     };
     let (set, dropped) = TrainSet::build(clips, names, dmax, &augmentation)?;
     set.report(&dropped, args.common.verbose).iter().for_each(|line| say(args, line));

@@ -98,7 +98,7 @@ pub fn fallback_stats(rest_row: &[Vec<f32>], trained: &[&AnyTopStats]) -> Result
         }
     }
     let mean: Vec<f32> = rest_row.concat();
-    let std: Vec<f32> = (0..rest_row.len()).flat_map(|j| if j == 0 { root.clone() } else { joint.clone() }).collect();
+    let std = AnyTopStats::grouped_rows(&root, &joint, rest_row.len());
     Ok(AnyTopStats { mean, std })
 }
 

@@ -23,7 +23,7 @@
 //! variants (each clip is re-encoded for one variant only), so augmentation at most about
 //! doubles the feature memory.
 
-use super::rest_norm::{RestNorm, RestToken};
+use super::rest_norm::{RestNorm, RestTokens};
 use crate::augment::{self, RemoveAmount};
 use crate::document::AnyTopSection;
 use crate::embed::NameTable;
@@ -81,11 +81,8 @@ pub struct Augmentation {
     pub stats: FallbackStats,
     /// The units a fallback-normalised draw's error is measured in (see `LossUnits`).
     pub units: LossUnits,
-    /// What the rest token is normalised by (`rest_norm::RestToken`); under `Global`, the
-    /// pooled statistics to use (a resumed or fine-tuned model's), or `None` to pool them from
-    /// the skeletons.
-    pub rest_token: RestToken,
-    pub rest_norm: Option<RestNorm>,
+    /// What the rest tokens are normalised by (`rest_norm::RestTokens`).
+    pub rest: RestTokens,
 }
 
 /// Which skeletons training normalises as sampling normalises a skeleton the model never saw
@@ -138,15 +135,7 @@ impl Augmentation {
 
     /// No augmentation.
     pub fn none() -> Augmentation {
-        Augmentation {
-            probability: 0.0,
-            variants: 0,
-            seed: 0,
-            stats: FallbackStats::None,
-            units: LossUnits::Normalised,
-            rest_token: RestToken::Skeleton,
-            rest_norm: None,
-        }
+        Augmentation { probability: 0.0, variants: 0, seed: 0, stats: FallbackStats::None, units: LossUnits::Normalised, rest: RestTokens::Skeleton }
     }
 
     /// The defaults with `seed`.
@@ -347,10 +336,9 @@ struct Norms<'a> {
 /// measured in `how.units`; its rest token by `how.rest` when given, else as the motion.
 fn normalised(mut data: SkeletonData, how: Norms) -> Result<SkeletonData, DataError> {
     let fail = |e: &dyn std::fmt::Display| DataError::Clip { clip: data.name.clone(), why: e.to_string() };
-    let (units, rest_norm) = (how.units, how.rest);
     if let Some(trained) = how.fallback {
         let own = std::mem::replace(&mut data.stats, crate::diffusion::condition::fallback_stats(&data.section.rest_row, trained).map_err(|e| fail(&e))?);
-        if units == LossUnits::Own {
+        if how.units == LossUnits::Own {
             data.loss_weights = Some(own_unit_weights(&own, &data.stats));
         }
     }
@@ -358,7 +346,7 @@ fn normalised(mut data: SkeletonData, how: Norms) -> Result<SkeletonData, DataEr
         data.stats.normalise(f).map_err(|e| fail(&e))?;
     }
     let mut rest = Features { frames: 1, joints: data.skeleton.len(), dims: anytop::FEATURE_DIMS, data: std::mem::take(&mut data.rest_row) };
-    match rest_norm {
+    match how.rest {
         Some(norm) => norm.for_joints(data.skeleton.len()).normalise(&mut rest),
         None => data.stats.normalise(&mut rest),
     }
@@ -476,16 +464,16 @@ impl TrainSet {
         let trained: Vec<AnyTopStats> = prepared.iter().map(|(_, _, _, d)| d.stats.clone()).collect();
         let trained: Vec<&AnyTopStats> = trained.iter().collect();
         let fallback = (aug.stats != FallbackStats::None).then_some(&trained[..]);
-        let rest_norm = match aug.rest_token {
-            RestToken::Skeleton => None,
-            RestToken::Global => Some(
-                aug.rest_norm
-                    .or_else(|| RestNorm::pool(prepared.iter().map(|(_, _, _, d)| d.rest_row.as_slice())))
+        let rest_norm = match aug.rest {
+            RestTokens::Skeleton => None,
+            RestTokens::Given(norm) => Some(norm),
+            RestTokens::Pool => Some(
+                RestNorm::pool(prepared.iter().map(|(_, _, _, d)| d.rest_row.as_slice()))
                     .ok_or_else(|| DataError::Clip { clip: "--rest-token global".into(), why: "no skeleton has a joint besides its root".into() })?,
             ),
         };
+        let norms = Norms { fallback, units: aug.units, rest: rest_norm.as_ref() };
         for (index, group, rest, data) in prepared {
-            let norms = Norms { fallback, units: aug.units, rest: rest_norm.as_ref() };
             let data = normalised(data, Norms { fallback: fallback.filter(|_| aug.stats == FallbackStats::All), ..norms })?;
             // Variants nobody will draw are not worth their memory.
             let wanted = if aug.probability > 0.0 { *aug } else { Augmentation { variants: 0, ..*aug } };
@@ -740,20 +728,22 @@ mod tests {
 
     #[test]
     fn a_global_rest_token_carries_every_skeletons_shape_under_the_fallback() {
-        let aug = |rest_token, rest_norm| Augmentation { stats: FallbackStats::All, rest_token, rest_norm, ..Augmentation::with_seed(7) };
+        let aug = |rest| Augmentation { stats: FallbackStats::All, rest, ..Augmentation::with_seed(7) };
         let build = |a: &Augmentation| TrainSet::build(zoo(), NameTable::builtin().unwrap(), topology::DEFAULT_DMAX, a).unwrap().0;
-        let zeros = build(&aug(RestToken::Skeleton, None));
+        let zeros = build(&aug(RestTokens::Skeleton));
         assert!(zeros.rest_norm.is_none());
         assert!(zeros.skeletons.iter().all(|s| s.rest_row.iter().all(|&x| x == 0.0)), "the fallback's mean is the rest pose");
-        let global = build(&aug(RestToken::Global, None));
+        let global = build(&aug(RestTokens::Pool));
         let norm = global.rest_norm.expect("pooled");
         let raw: Vec<Vec<f32>> = global.skeletons.iter().map(|s| s.section.rest_row.concat()).collect();
         assert_eq!(Some(norm), RestNorm::pool(raw.iter().map(|r| r.as_slice())), "pooled over the skeletons' rest rows");
-        for (s, raw) in global.skeletons.iter().chain(global.augmented.iter().flatten()).zip(raw.iter().chain(std::iter::repeat(&Vec::new()))) {
+        for s in global.skeletons.iter().chain(global.augmented.iter().flatten()) {
             let mut expected = Features { frames: 1, joints: s.skeleton.len(), dims: anytop::FEATURE_DIMS, data: s.section.rest_row.concat() };
             norm.for_joints(s.skeleton.len()).normalise(&mut expected).unwrap();
             assert_eq!(s.rest_row, expected.data, "{}", s.name);
-            assert!(raw.is_empty() || s.rest_row.iter().any(|&x| x.abs() > 0.5), "{}: a shape, not zeros", s.name);
+        }
+        for s in &global.skeletons {
+            assert!(s.rest_row.iter().any(|&x| x.abs() > 0.5), "{}: a shape, not zeros", s.name);
         }
         // The motion is normalised as before; only the rest token changes.
         for (a, b) in global.skeletons.iter().zip(&zeros.skeletons) {
@@ -762,7 +752,7 @@ mod tests {
         // Given statistics (a resumed model's) are used as they are, not pooled again.
         let mut other = norm;
         other.mean[1][0] += 1.0;
-        let given = build(&aug(RestToken::Global, Some(other)));
+        let given = build(&aug(RestTokens::Given(other)));
         assert_eq!(given.rest_norm, Some(other));
         assert_ne!(given.skeletons[0].rest_row, global.skeletons[0].rest_row);
     }

@@ -24,6 +24,38 @@ pub enum RestToken {
     Global,
 }
 
+/// How a training set's rest tokens are normalised: a `RestToken` with the statistics it uses.
+// Made once per training run (and copied with `data::Augmentation`): its 208 bytes cost nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum RestTokens {
+    /// By each skeleton's statistics.
+    #[default]
+    Skeleton,
+    /// By statistics pooled over the set's skeletons.
+    Pool,
+    /// By these (a resumed or fine-tuned model's).
+    Given(RestNorm),
+}
+
+impl RestTokens {
+    /// `token`, with the statistics a model already has (`known`) when it has them.
+    pub fn of(token: RestToken, known: Option<RestNorm>) -> RestTokens {
+        match (token, known) {
+            (RestToken::Skeleton, _) => RestTokens::Skeleton,
+            (RestToken::Global, Some(norm)) => RestTokens::Given(norm),
+            (RestToken::Global, None) => RestTokens::Pool,
+        }
+    }
+
+    pub fn token(&self) -> RestToken {
+        match self {
+            RestTokens::Skeleton => RestToken::Skeleton,
+            RestTokens::Pool | RestTokens::Given(_) => RestToken::Global,
+        }
+    }
+}
+
 /// Mean and spread of the rest rows of the trained skeletons: row 0 the roots', row 1 every
 /// other joint's.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -72,8 +104,10 @@ impl RestNorm {
 
     /// As statistics of a skeleton of `joints` joints, for `AnyTopStats::normalise`.
     pub fn for_joints(&self, joints: usize) -> AnyTopStats {
-        let row = |j: usize| usize::from(j > 0);
-        AnyTopStats { mean: (0..joints).flat_map(|j| self.mean[row(j)]).collect(), std: (0..joints).flat_map(|j| self.std[row(j)]).collect() }
+        AnyTopStats {
+            mean: AnyTopStats::grouped_rows(&self.mean[0], &self.mean[1], joints),
+            std: AnyTopStats::grouped_rows(&self.std[0], &self.std[1], joints),
+        }
     }
 }
 
@@ -85,10 +119,9 @@ mod tests {
     fn pooling_keeps_roots_apart_and_floors_the_spread() {
         let d = FEATURE_DIMS;
         // Two skeletons: 2 and 3 joints; value k of joint j is j + k, the root's 10k.
-        let row = |joints: usize, shift: f32| -> Vec<f32> {
-            (0..joints).flat_map(|j| (0..d).map(move |k| if j == 0 { 10.0 * k as f32 } else { j as f32 + k as f32 + shift })).collect()
-        };
-        let (a, b) = (row(2, 0.0), row(3, 0.0));
+        let row =
+            |joints: usize| -> Vec<f32> { (0..joints).flat_map(|j| (0..d).map(move |k| if j == 0 { 10.0 * k as f32 } else { (j + k) as f32 })).collect() };
+        let (a, b) = (row(2), row(3));
         let norm = RestNorm::pool([a.as_slice(), b.as_slice()]).unwrap();
         // Roots alike: mean 10k, no spread, so the floor.
         assert_eq!(norm.mean[0][3], 30.0);

@@ -131,16 +131,19 @@ fn fallback_stats_are_recorded_and_kept_by_resume() {
     for flag in ["--fallback-stats", "--loss-units"] {
         let mut args = train_args(&data, &sata, "1");
         args.extend(["--arch", "sata", flag, if flag == "--loss-units" { "own" } else { "variants" }]);
-        let out = run("mo-train", &args, None);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(out.status.code() == Some(2) && stderr.contains(flag) && !sata.exists(), "{stderr}");
+        refused(&args, flag, &sata);
     }
     let alone = dir.join("alone");
     let mut args = train_args(&data, &alone, "1");
     args.extend(["--loss-units", "own"]);
-    let out = run("mo-train", &args, None);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.code() == Some(2) && stderr.contains("--fallback-stats") && !alone.exists(), "{stderr}");
+    refused(&args, "--fallback-stats", &alone);
+}
+
+/// `mo-train ARGS` fails with exit 2, an error naming `needle`, and no `out`.
+fn refused(args: &[&str], needle: &str, out: &Path) {
+    let result = run("mo-train", args, None);
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(result.status.code() == Some(2) && stderr.contains(needle) && !out.exists(), "{stderr}");
 }
 
 /// --rest-token global: the pooled rest statistics are recorded, a resume keeps them, a fine-tune

@@ -80,6 +80,12 @@ impl AnyTopStats {
         Ok(())
     }
 
+    /// `[joints * 13]` values from one row for the root and one that every other joint shares
+    /// (the grouping of the spreads above).
+    pub fn grouped_rows(root: &[f32], others: &[f32], joints: usize) -> Vec<f32> {
+        (0..joints).flat_map(|j| if j == 0 { root } else { others }).copied().collect()
+    }
+
     /// x̂ = (x − mean)/(std + ε), in place.
     pub fn normalise(&self, features: &mut Features) -> Result<(), AnyTopError> {
         self.apply(features, |x, m, s| (x - m) / (s + STD_EPSILON))
