@@ -1,5 +1,5 @@
 complete -c mo-sample -l skeleton -d 'The same as SKELETON, as a named option' -r -F
-complete -c mo-sample -l model -d 'Model directory written by mo-train [default: the built-in model, a compact denoiser trained on the synthetic zoo; see models/zoo-compact/MODEL_CARD.md]' -r -F
+complete -c mo-sample -l model -d 'Model directory written by mo-train, with an optional unseen/ model directory beside its files for skeletons it was not trained on [default: the built-in model, a compact denoiser pair trained on the synthetic zoo; see models/zoo-compact/MODEL_CARD.md]' -r -F
 complete -c mo-sample -s n -l samples -d 'Number of samples' -r
 complete -c mo-sample -l frames -d 'Frames per sample [default: 120; with --reference: the reference\'s length; with --examples: the longest clip\'s]' -r
 complete -c mo-sample -l seconds -d 'Length in seconds (at the skeleton\'s frame rate)' -r

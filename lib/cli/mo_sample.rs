@@ -8,6 +8,7 @@ use crate::diffusion::condition::{SkeletonCondition, StatsSource};
 use crate::diffusion::edit;
 use crate::diffusion::keep::Reference;
 use crate::diffusion::sample::{sample, PostProcess, SampleOptions, DEFAULT_BLEND_SECONDS, DEFAULT_SMOOTH_HZ};
+use crate::diffusion::unseen;
 use crate::diffusion::Sampler;
 use crate::motion::write::MotionFormat;
 use crate::repr::anytop::{AnyTopRig, IkOptions, Placement};
@@ -61,7 +62,11 @@ pub fn sample_frames(seconds: f64, fps: f64) -> anyhow::Result<usize> {
 /// same samples (fine-tune on its clips to give a model its own). A trained skeleton (same names,
 /// parents and proportions) also keeps the rest pose training took from its first clip, so any of
 /// its files or documents gives the same samples (-v says so); another skeleton's rest pose is
-/// the first frame of the file given.
+/// the first frame of the file given. A model directory may hold a second denoiser in unseen/,
+/// trained under that rest-pose normalisation (mo-train --fallback-stats all); it samples every
+/// skeleton the main one was not trained on. The built-in model has one: its main denoiser
+/// moves its own zoo like the clips but stands other skeletons still, its unseen one moves them
+/// (held-out dragon: 0.90 of the clip's motion against 0.42).
 ///
 /// Sampling: the default, 10 DDIM steps, keeps `mo-sample -n 4` of a 40-joint creature under
 /// 10 s on two slow cores; --steps 100 --sampler ddpm is the reference's full ancestral loop
@@ -120,8 +125,9 @@ pub struct Args {
     /// The same as SKELETON, as a named option.
     #[arg(long = "skeleton", value_name = "PATH", conflicts_with = "skeleton")]
     pub skeleton_option: Option<PathBuf>,
-    /// Model directory written by mo-train [default: the built-in model, a compact denoiser
-    /// trained on the synthetic zoo; see models/zoo-compact/MODEL_CARD.md].
+    /// Model directory written by mo-train, with an optional unseen/ model directory beside
+    /// its files for skeletons it was not trained on [default: the built-in model, a compact
+    /// denoiser pair trained on the synthetic zoo; see models/zoo-compact/MODEL_CARD.md].
     #[arg(long, value_name = "DIR")]
     pub model: Option<PathBuf>,
     /// Number of samples.
@@ -202,6 +208,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         None => arg.record()?,
     };
+    // A skeleton the model was not trained on is sampled by the model's unseen-skeleton
+    // denoiser when it has one: trained under the normalisation such a skeleton gets below, it
+    // moves skeletons the main one stands still (`diffusion::unseen`).
+    let unseen = match checkpoint::find_trained(&loaded.info.skeletons, skeleton) {
+        Some(_) => None,
+        None => unseen::frozen_or_default(args.model.as_deref(), &device)?,
+    };
+    let denoiser = unseen.as_ref().unwrap_or(&loaded);
     super::ood::Known::denoiser(args.model.as_deref(), &loaded.info)?.warn("mo-sample", &arg.name, skeleton, args.common.quiet)?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     let reference = match &args.reference {
@@ -224,7 +238,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // Every sample goes through the denoiser at once: a few activations of its width per
     // joint and frame.
     let tokens = count as u128 * frames as u128 * skeleton.len() as u128;
-    crate::budget::check(&format!("{count} samples of {frames} frames on {} joints", skeleton.len()), tokens, loaded.info.config.width * 4 * 4)?;
+    crate::budget::check(&format!("{count} samples of {frames} frames on {} joints", skeleton.len()), tokens, denoiser.info.config.width * 4 * 4)?;
     let mask = reference.as_ref().map(|r| r.mask(args.keep_frames.as_deref(), args.keep_joints.as_deref(), skeleton, frames)).transpose()?;
 
     // A skeleton the model never saw is normalised by its rest pose and the trained skeletons'
@@ -232,20 +246,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // built-in model's poses were 2-12x farther from the clip's on six real skeletons
     // (models/zoo-compact/MODEL_CARD.md, "The pipe and the file"), and the file and the pipe
     // now sample alike.
-    let condition = SkeletonCondition::new(&loaded.info, skeleton, &section.rest_row).with_context(|| arg.name.clone())?;
+    let condition = SkeletonCondition::new(&denoiser.info, skeleton, &section.rest_row).with_context(|| arg.name.clone())?;
     if condition.stats_source == StatsSource::Fallback {
+        let by = if unseen.is_some() { ", with the model's unseen-skeleton denoiser" } else { "" };
         args.common
             .say("mo-sample")
-            .info(format_args!("{}: not a trained skeleton: normalising by its rest pose and the trained skeletons' spreads", arg.name));
+            .info(format_args!("{}: not a trained skeleton: normalising by its rest pose and the trained skeletons' spreads{by}", arg.name));
     }
     let cond = condition.condition();
     let post = PostProcess::new(args.smooth, args.blend, !args.no_plant_feet, fps, crate::cli::bounds::MAX_SECONDS)?;
-    let schedule = loaded.info.schedule();
+    let schedule = denoiser.info.schedule();
     let opts = SampleOptions { samples: count, frames, steps: args.steps as usize, sampler: args.sampler, seed: args.common.seed };
     let started = std::time::Instant::now();
     let mut samples = match (&reference, &mask) {
-        (Some(r), Some(mask)) => edit::sample_edit(&loaded.model, &schedule, &cond, &opts, &r.features.padded_to(frames), mask, &device)?,
-        _ => sample(&loaded.model, &schedule, &cond, &opts, &device)?,
+        (Some(r), Some(mask)) => edit::sample_edit(&denoiser.model, &schedule, &cond, &opts, &r.features.padded_to(frames), mask, &device)?,
+        _ => sample(&denoiser.model, &schedule, &cond, &opts, &device)?,
     };
     let fixed = mask.as_ref().map(|m| m.keep.as_slice());
     for f in &mut samples {

@@ -141,7 +141,9 @@ pub struct Args {
     pub augment_variants: u64,
     /// anytop: what training normalises as sampling normalises a skeleton the model never saw
     /// (the rest pose as the mean, the skeletons' average spreads) instead of by its own clips'
-    /// statistics, so that the model learns the condition it gets zero-shot [default: none;
+    /// statistics, so that the model learns the condition it gets zero-shot. A model trained
+    /// with `all` can go in another model's unseen/ folder, where mo-sample takes it for every
+    /// skeleton that model was not trained on (the built-in model is such a pair) [default: none;
     /// with --resume the checkpoint's]
     #[arg(long, value_name = "WHAT", value_enum)]
     pub fallback_stats: Option<FallbackStats>,

@@ -111,12 +111,12 @@ pub enum FallbackStats {
 /// little next to it (the spider's joints move 0.39 of the average spread, its velocities
 /// 0.60) has a small signal in those units, so predicting its rest pose costs little. Under
 /// `--fallback-stats all` the bundled spider's motion energy fell from 0.91 of its clips' to
-/// 0.20 (models/zoo-compact-fallback/MODEL_CARD.md). Measuring the error in the skeleton's own
+/// 0.20 (models/zoo-compact/unseen/MODEL_CARD.md). Measuring the error in the skeleton's own
 /// units (its clips' spreads) weighs it as upstream's per-skeleton normalisation does, while
 /// the model still reads and writes the fallback's units it gets zero-shot. Measured, it is not
 /// the fix: 5,762 steps from that run's step 21,234 left the spider at 0.31 (the `normalised`
 /// run read 0.20-0.37 over its checkpoints), and no other skeleton moved beyond the readings'
-/// noise (models/zoo-compact-fallback/MODEL_CARD.md).
+/// noise (models/zoo-compact/unseen/MODEL_CARD.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum LossUnits {

@@ -14,6 +14,7 @@ pub mod schedule;
 pub mod start;
 pub mod train;
 pub mod trainer;
+pub mod unseen;
 
 pub use schedule::{Sampler, Schedule, Step};
 

@@ -6,7 +6,7 @@
 //! zeros: the model is told nothing of where its legs point or how long they are, only its
 //! topology and joint names. Under `--fallback-stats all` every skeleton trains that way, and
 //! the bundled spider (eight legs whose names tell little apart) lost its gait
-//! (models/zoo-compact-fallback/MODEL_CARD.md). `Global` normalises P_S by statistics pooled
+//! (models/zoo-compact/unseen/MODEL_CARD.md). `Global` normalises P_S by statistics pooled
 //! over the trained skeletons' rest rows instead (the root's row apart from the other
 //! joints'), the same for every skeleton, seen or not, so the rest token always carries the
 //! skeleton's shape.

@@ -149,3 +149,39 @@ fn an_untrained_skeleton_samples_alike_from_its_file_and_its_document() {
     let (from_document, _) = sample(&doc_path, "document");
     assert_eq!(from_file, from_document, "the document's statistics changed the samples");
 }
+
+/// A model directory's unseen/ denoiser (trained under --fallback-stats all) samples every
+/// skeleton the main one was not trained on, and only those; one trained on own statistics is
+/// refused there.
+#[test]
+fn a_skeleton_the_model_never_saw_is_sampled_by_its_unseen_denoiser() {
+    let dir = tempdir("unseen-denoiser");
+    let model = dir.join("model");
+    train_two_steps(&example("quadruped.bvh"), &model);
+    let (crab, quadruped) = (example("crab.bvh"), example("quadruped.bvh"));
+    let (crab_alone, said) = sample_bvh(&dir, &model, &crab, "crab-alone");
+    assert!(!said.contains("unseen-skeleton denoiser"), "{said}");
+    let (quadruped_alone, _) = sample_bvh(&dir, &model, &quadruped, "quadruped-alone");
+
+    let unseen = model.join("unseen");
+    let train = ["--out", s(&unseen), "--preset", "tiny", "--steps", "2", "--batch", "2", "--crop", "12", "-q", "--fallback-stats", "all"];
+    ok(&run("mo-train", &[&[s(&quadruped)][..], &train].concat(), None), "train the unseen denoiser");
+    let (crab_pair, said) = sample_bvh(&dir, &model, &crab, "crab-pair");
+    assert!(said.contains("not a trained skeleton") && said.contains("with the model's unseen-skeleton denoiser"), "{said}");
+    let (crab_unseen, _) = sample_bvh(&dir, &unseen, &crab, "crab-unseen");
+    assert_eq!(crab_pair, crab_unseen, "the crab is sampled by unseen/ as by that model alone");
+    assert_ne!(crab_pair, crab_alone, "unseen/ changed nothing");
+    let (quadruped_pair, said) = sample_bvh(&dir, &model, &quadruped, "quadruped-pair");
+    assert!(!said.contains("unseen-skeleton denoiser"), "{said}");
+    assert_eq!(quadruped_pair, quadruped_alone, "a trained skeleton is sampled by the main denoiser");
+
+    // A denoiser trained on own statistics in unseen/ is refused, naming it and the fix.
+    for f in ["checkpoint.json", "model.safetensors"] {
+        std::fs::copy(model.join(f), unseen.join(f)).unwrap();
+    }
+    let bvh = dir.join("refused.bvh");
+    let out = run("mo-sample", &[s(&crab), "--model", s(&model), "--frames", "12", "--steps", "3", "--bvh", s(&bvh)], None);
+    check_failure("mo-sample", "unseen/ trained on own statistics", &out, "--fallback-stats all");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unseen"), "the message names the folder");
+    assert!(!bvh.exists(), "no partial output");
+}
