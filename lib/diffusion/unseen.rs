@@ -31,18 +31,17 @@ pub const BUILTIN_NAME: &str = "the built-in default model's unseen-skeleton den
 /// on: `dir/unseen` when it exists (`None` when it does not), checked to have trained under the
 /// fallback statistics it will sample with.
 pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<Option<FrozenDenoiser>, CheckpointError> {
-    let loaded = match dir {
+    let (loaded, name) = match dir {
         Some(dir) => {
             let unseen = dir.join(UNSEEN_DIR);
             if !unseen.is_dir() {
                 return Ok(None);
             }
-            checkpoint::frozen(&unseen, device)?
+            (checkpoint::frozen(&unseen, device)?, format!("model {}", unseen.display()))
         }
-        None => checkpoint::frozen_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))?,
+        None => (checkpoint::frozen_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))?, BUILTIN_NAME.to_string()),
     };
-    let name = dir.map_or_else(|| BUILTIN_NAME.to_string(), |d| format!("model {}", d.join(UNSEEN_DIR).display()));
-    check(&loaded.info).map_err(|why| CheckpointError::Invalid(format!("{name}: {why}")))?;
+    check(&loaded.info).map_err(|why| CheckpointError::of(name)(CheckpointError::Invalid(why)))?;
     Ok(Some(loaded))
 }
 
