@@ -6,6 +6,7 @@ use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, FallbackStats, LossUnits, TrainSet};
 use crate::diffusion::rest_norm::{RestNorm, RestToken, RestTokens};
 use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
+use crate::diffusion::unseen;
 use crate::embed::NameTable;
 use crate::nn::{DenoiserConfig, Preset};
 use crate::sata::trainer::{SataOptions, SataResume, SataTrainer};
@@ -66,7 +67,9 @@ EXAMPLES:
 /// 1,900-9,800 of the built-in model's on two quiet cores, fewer the more joints;
 /// models/zoo-compact/MODEL_CARD.md, "Fine-tuning"). With --minutes it trains for a wall-time
 /// budget rather than a step count. The result is an ordinary model directory for mo-sample,
-/// mo-dift and mo-segment --model.
+/// mo-dift and mo-segment --model. It gets the starting model's unseen-skeleton denoiser
+/// (OUT/unseen, the built-in's for --init builtin), so mo-sample --model OUT samples the
+/// skeletons it was not tuned on as the starting model does.
 ///
 /// --resume continues with the checkpoint's --lr, --batch, --crop and --augment unless they
 /// are given, so a fine-tune resumes as a fine-tune; given ones are recorded in the
@@ -401,7 +404,22 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         None => resolved.rest,
     };
     let set = training_set(args, resolved, seed, start.dmax(), rest)?;
+    let fine_tune = matches!(start, AnyTopStart::Init(_));
     let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, device).map_err(explain)?;
+    if fine_tune {
+        // The tuned model samples other skeletons as the model it starts from did.
+        let init = args.init.as_deref().filter(|dir| dir.as_os_str() != "builtin");
+        if unseen::carry(init, &args.out)? {
+            say(
+                args,
+                &format!(
+                    "carried the unseen-skeleton denoiser of {} into {}",
+                    init.map_or("the built-in model".to_string(), |d| d.display().to_string()),
+                    args.out.join(unseen::UNSEEN_DIR).display()
+                ),
+            );
+        }
+    }
     train(args, resolved, trainer.first_step(), &mut trainer)
 }
 

@@ -45,6 +45,41 @@ pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<Option<F
     Ok(Some(loaded))
 }
 
+/// Gives a fine-tune in `out` the unseen-skeleton denoiser of the model it starts from (`None`:
+/// the built-in one), when that model has one: a model tuned on one creature then samples every
+/// other skeleton as its starting model did, instead of with a main denoiser that never trained
+/// under the fallback statistics (it stands them still). Only what sampling reads is written
+/// (weights and `checkpoint.json`), checked as sampling checks it, into a temporary folder moved
+/// into place. Returns whether `out/unseen` was written; an existing one is left alone.
+pub fn carry(init: Option<&Path>, out: &Path) -> Result<bool, CheckpointError> {
+    let target = out.join(UNSEEN_DIR);
+    if target.exists() {
+        return Ok(false);
+    }
+    let (info, weights) = match init {
+        None => (BUILTIN_INFO.to_vec(), BUILTIN_WEIGHTS.to_vec()),
+        Some(dir) => {
+            if !dir.join(UNSEEN_DIR).is_dir() {
+                return Ok(false);
+            }
+            checkpoint::read_dir_files(&dir.join(UNSEEN_DIR))?
+        }
+    };
+    if init.is_some() {
+        // The same check sampling makes, so a fine-tune never carries a denoiser it would refuse.
+        frozen_or_default(init, &Device::Cpu)?;
+    }
+    let temporary = out.join(format!(".{UNSEEN_DIR}.partial"));
+    let _ = std::fs::remove_dir_all(&temporary);
+    std::fs::create_dir_all(&temporary).map_err(CheckpointError::io(format!("cannot create {}", temporary.display())))?;
+    std::fs::write(temporary.join("checkpoint.json"), &info)
+        .map_err(CheckpointError::io(format!("cannot write {}", temporary.join("checkpoint.json").display())))?;
+    std::fs::write(temporary.join("model.safetensors"), &weights)
+        .map_err(CheckpointError::io(format!("cannot write {}", temporary.join("model.safetensors").display())))?;
+    std::fs::rename(&temporary, &target).map_err(CheckpointError::io(format!("cannot move {} into place", target.display())))?;
+    Ok(true)
+}
+
 /// Why `info` cannot serve skeletons a model was not trained on, if it cannot.
 fn check(info: &CheckpointInfo) -> Result<(), String> {
     match info.fallback_stats {

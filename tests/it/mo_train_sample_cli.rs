@@ -96,6 +96,52 @@ fn sample_bvh(dir: &Path, model: &Path, skeleton: &Path, tag: &str) -> (Vec<u8>,
     (std::fs::read(&bvh).unwrap(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
+/// A fine-tune carries the unseen-skeleton denoiser of the model it starts from: `--init builtin`
+/// writes the built-in's (the bytes of models/zoo-compact/unseen), `--init DIR` copies DIR's,
+/// and a skeleton the fine-tune did not train on is then sampled by it; a model without one
+/// passes nothing on.
+#[test]
+fn a_fine_tune_carries_its_models_unseen_denoiser() {
+    let dir = tempdir("carry-unseen");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tune = |init: &Path, data: &Path, out: &Path| {
+        let args = [s(data), "--init", s(init), "--out", s(out), "--steps", "1", "--batch", "1", "--crop", "12"];
+        let said = run("mo-train", &args, None);
+        ok(&said, "fine-tune");
+        String::from_utf8_lossy(&said.stderr).into_owned()
+    };
+    let from_builtin = dir.join("from-builtin");
+    let said = tune(Path::new("builtin"), &example("quadruped.bvh"), &from_builtin);
+    assert!(said.contains("carried the unseen-skeleton denoiser of the built-in model"), "{said}");
+    for f in ["checkpoint.json", "model.safetensors"] {
+        let carried = std::fs::read(from_builtin.join("unseen").join(f)).unwrap();
+        assert!(carried == std::fs::read(root.join("models/zoo-compact/unseen").join(f)).unwrap(), "unseen/{f} is not the built-in's");
+    }
+    assert!(!from_builtin.join(".unseen.partial").exists(), "the temporary folder is left behind");
+    // A skeleton neither the built-in nor the tuned model trained on (an augmented crab) samples
+    // from the tuned model as from the built-in: both through the built-in's unseen denoiser.
+    let crab = dir.join("crab_aug.bvh");
+    ok(&run("skel-aug", &[s(&example("crab.bvh")), "--add", "2", "--seed", "7", "-o", s(&crab)], None), "skel-aug");
+    let (tuned, said) = sample_bvh(&dir, &from_builtin, &crab, "crab-tuned");
+    assert!(said.contains("with the model's unseen-skeleton denoiser"), "{said}");
+    let bvh = dir.join("crab-builtin.bvh");
+    ok(&run("mo-sample", &[s(&crab), "--frames", "12", "--steps", "3", "--seed", "5", "--bvh", s(&bvh), "-q"], None), "builtin");
+    assert!(tuned == std::fs::read(&bvh).unwrap(), "the tuned model samples an unseen skeleton unlike the built-in");
+
+    // From a directory: its unseen/ goes on to the next fine-tune, byte for byte.
+    let from_dir = dir.join("from-dir");
+    tune(&from_builtin, &example("bird.bvh"), &from_dir);
+    for f in ["checkpoint.json", "model.safetensors"] {
+        assert!(std::fs::read(from_dir.join("unseen").join(f)).unwrap() == std::fs::read(from_builtin.join("unseen").join(f)).unwrap(), "unseen/{f}");
+    }
+    // A model without one: nothing is carried, and nothing said.
+    let plain = dir.join("plain");
+    train_two_steps(&example("quadruped.bvh"), &plain);
+    let from_plain = dir.join("from-plain");
+    let said = tune(&plain, &example("bird.bvh"), &from_plain);
+    assert!(!from_plain.join("unseen").exists() && !said.contains("carried"), "{said}");
+}
+
 /// A trained skeleton samples the same from any of its clips: the rest pose (rig and P_S) is
 /// the one training built, from its rest clip's first frames, not the given file's. A
 /// checkpoint without the recorded rest (written before it existed) falls back to the file's.
