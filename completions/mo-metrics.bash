@@ -347,7 +347,7 @@ _mo__metrics() {
             return 0
             ;;
         mo__subcmd__metrics__subcmd__ood)
-            opts="-o -q -v -h --model --latent --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
+            opts="-o -q -v -h --model --latent --unseen --format --skeleton --from --output --seed --quiet --verbose --threads --animation --fps --help"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 2 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

@@ -57,6 +57,7 @@ complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l threads -d
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l animation -d 'glTF inputs: the animation that becomes the motion, by name or by index from 0 (default: the first)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l latent -d 'Score against a latent model (SATA: mo-encode --latent, mo-retarget --method latent)'
+complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -l unseen -d 'Score against the diffusion model\'s unseen-skeleton denoiser (DIR/unseen; the built-in has one) and its limit: how mo-sample judges a skeleton the main denoiser was not trained on, which it samples with that denoiser'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-metrics -n "__fish_mo_metrics_using_subcommand ood" -s h -l help -d 'Print help (see more with \'--help\')'

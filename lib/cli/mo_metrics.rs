@@ -95,6 +95,11 @@ pub enum Command {
         /// Score against a latent model (SATA: mo-encode --latent, mo-retarget --method latent).
         #[arg(long)]
         latent: bool,
+        /// Score against the diffusion model's unseen-skeleton denoiser (DIR/unseen; the
+        /// built-in has one) and its limit: how mo-sample judges a skeleton the main denoiser
+        /// was not trained on, which it samples with that denoiser.
+        #[arg(long, conflicts_with = "latent")]
+        unseen: bool,
     },
     /// AnyTop's generation metrics: generated samples against ground-truth clips of one skeleton.
     ///
@@ -242,7 +247,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             run_transfer(args, source, result, binding.as_deref(), examples, *seconds, *fid_window)?
         }
         Command::Aggregate { reports } => report::aggregate_report(&report::read_reports(reports)?)?,
-        Command::Ood { skeletons, model, latent } => run_ood(args, skeletons, model.as_deref(), *latent)?,
+        Command::Ood { skeletons, model, latent, unseen } => run_ood(args, skeletons, model.as_deref(), *latent, *unseen)?,
         Command::Generation { gt, generated, window, threshold, min_segment } => {
             let opts =
                 GenerationOptions { window: *window, threshold: *threshold, min_segment: *min_segment, seed: args.common.seed, ..GenerationOptions::default() };
@@ -257,10 +262,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(io::write_output(args.common.output.as_deref(), text.as_bytes())?)
 }
 
-fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: bool) -> anyhow::Result<Value> {
+fn run_ood(args: &Args, skeletons: &[PathBuf], model: Option<&Path>, latent: bool, unseen: bool) -> anyhow::Result<Value> {
     let device = candle_core::Device::Cpu;
     let known = if latent {
         super::ood::Known::latent(model, &crate::sata::clips::frozen_or_default(model, &device)?.rigs)?
+    } else if unseen {
+        let Some(denoiser) = crate::diffusion::unseen::frozen_or_default(model, &device)? else {
+            bail!(
+                "--unseen: {} has no unseen-skeleton denoiser (an unseen/ model directory inside it)",
+                model.map_or("the model".into(), |d| d.display().to_string())
+            );
+        };
+        super::ood::Known::unseen_denoiser(model, &denoiser.info)?
     } else {
         super::ood::Known::denoiser(model, &crate::diffusion::checkpoint::frozen_or_default(model, &device)?.info)?
     };

@@ -216,7 +216,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => unseen::frozen_or_default(args.model.as_deref(), &device)?,
     };
     let denoiser = unseen.as_ref().unwrap_or(&loaded);
-    super::ood::Known::denoiser(args.model.as_deref(), &loaded.info)?.warn("mo-sample", &arg.name, skeleton, args.common.quiet)?;
+    // The warning judges the skeleton against the denoiser that samples it, by that one's limit.
+    let known = match &unseen {
+        Some(u) => super::ood::Known::unseen_denoiser(args.model.as_deref(), &u.info)?,
+        None => super::ood::Known::denoiser(args.model.as_deref(), &loaded.info)?,
+    };
+    known.warn("mo-sample", &arg.name, skeleton, args.common.quiet)?;
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     let reference = match &args.reference {
         Some(path) => {

@@ -2,7 +2,7 @@
 //! model's training skeletons as a reference, and one stderr line for a skeleton out of range.
 
 use crate::diffusion::checkpoint::CheckpointInfo;
-use crate::ood::{warning, Reference, Score};
+use crate::ood::{warning, Reference, Score, UNSEEN_LIMIT};
 use crate::sata::rigs::KnownRigs;
 use crate::skeleton::Skeleton;
 use std::path::Path;
@@ -19,6 +19,17 @@ impl Known {
     pub fn denoiser(dir: Option<&Path>, info: &CheckpointInfo) -> anyhow::Result<Known> {
         let model = model_label(dir, crate::diffusion::checkpoint::BUILTIN_NAME);
         Ok(Known { reference: info.ood_reference()?, model })
+    }
+
+    /// The training skeletons of the unseen-skeleton denoiser of the model in `dir` (none: the
+    /// built-in's), judged by `UNSEEN_LIMIT`: what `mo-sample` samples a skeleton the main
+    /// denoiser was not trained on with.
+    pub fn unseen_denoiser(dir: Option<&Path>, info: &CheckpointInfo) -> anyhow::Result<Known> {
+        let model = dir.map_or_else(
+            || crate::diffusion::unseen::BUILTIN_NAME.to_string(),
+            |d| format!("model {}", d.join(crate::diffusion::unseen::UNSEEN_DIR).display()),
+        );
+        Ok(Known { reference: info.ood_reference()?.with_limit(UNSEEN_LIMIT), model })
     }
 
     /// The latent model's training skeletons (its `rigs.json`).

@@ -87,3 +87,39 @@ fn real_captures_the_builtin_model_fails_on_are_out_of_range() {
         }
     }
 }
+
+/// A skeleton the main denoiser was not trained on is sampled by the built-in's unseen-skeleton
+/// denoiser, and `mo-sample` judges it by that denoiser's limit (docs/ood.md: the captures whose
+/// zero-shot samples met issue 22's bars lie within it, the ones that did not outside): the
+/// LAFAN1 walk is sampled without a warning, the Monkey with one naming that denoiser, and
+/// `mo-metrics ood --unseen` says the same as JSON. A model without an unseen/ is refused.
+#[test]
+fn skeletons_sampled_by_the_unseen_denoiser_are_judged_by_its_limit() {
+    let Some(data) = common::shared_data("skeletons_sampled_by_the_unseen_denoiser_are_judged_by_its_limit") else { return };
+    let dir = tempdir("ood-unseen");
+    let bvh = data.join("bvh");
+    let (walk, monkey) = (bvh.join("lafan1/walk4_subject1.bvh"), bvh.join("truebones_motion2motion/Monkey/__Walk.bvh"));
+    let sample = |clip: &Path, tag: &str| {
+        let out = run("mo-sample", &[s(clip), "--frames", "8", "--steps", "2", "-o", s(&dir.join(format!("{tag}.npy")))], None);
+        ok(&out, tag);
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let said = sample(&walk, "walk");
+    assert!(!said.contains("warning"), "{said}");
+    let said = sample(&monkey, "monkey");
+    assert!(said.contains("warning") && said.contains("unseen-skeleton denoiser's training range") && said.contains("limit 0.48"), "{said}");
+
+    let report = ood_json(&["--unseen", s(&walk), s(&monkey)]);
+    assert_eq!(report["limit"].as_f64(), Some(menagerie::ood::UNSEEN_LIMIT));
+    let in_range: Vec<Option<bool>> = (0..2).map(|k| report["skeletons"][k]["ood"]["in_range"].as_bool()).collect();
+    assert_eq!(in_range, [Some(true), Some(false)], "{report}");
+    // Against the main denoiser's limit both are out, as before.
+    let main = ood_json(&[s(&walk), s(&monkey)]);
+    assert_eq!((0..2).map(|k| main["skeletons"][k]["ood"]["in_range"].as_bool()).collect::<Vec<_>>(), [Some(false), Some(false)]);
+
+    let plain = dir.join("plain");
+    let quad = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/quadruped.bvh");
+    ok(&run("mo-train", &[s(&quad), "--out", s(&plain), "--preset", "tiny", "--steps", "1", "--batch", "1", "--crop", "12", "-q"], None), "train");
+    let out = run("mo-metrics", &["ood", "--unseen", "--model", s(&plain), s(&quad)], None);
+    common::check_failure("mo-metrics", "--unseen without unseen/", &out, "no unseen-skeleton denoiser");
+}
