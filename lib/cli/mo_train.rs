@@ -387,6 +387,10 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
     };
     // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.
     refuse_to_overwrite(args)?;
+    // A fine-tune samples other skeletons as the model it starts from did (`unseen::Carried`);
+    // one sampling would refuse stops the run here, before any message or output.
+    let init = args.init.as_deref().filter(|dir| dir.as_os_str() != "builtin");
+    let carried = if args.init.is_some() && !args.resume { unseen::Carried::from(init)? } else { None };
     // The checkpoint first: a resumed run must rebuild the data (augmented variants
     // included) from the seed the run started with.
     let (start, notes) = AnyTopStart::choose(&args.out, args.resume, args.init.as_deref(), resolved.lr, &opts, device)?;
@@ -404,12 +408,9 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         None => resolved.rest,
     };
     let set = training_set(args, resolved, seed, start.dmax(), rest)?;
-    let fine_tune = matches!(start, AnyTopStart::Init(_));
     let mut trainer = AnyTopTrainer::new(&args.out, &opts, start, set, device).map_err(explain)?;
-    if fine_tune {
-        // The tuned model samples other skeletons as the model it starts from did.
-        let init = args.init.as_deref().filter(|dir| dir.as_os_str() != "builtin");
-        if unseen::carry(init, &args.out)? {
+    if let Some(carried) = carried {
+        if carried.write(&args.out)? {
             say(
                 args,
                 &format!(

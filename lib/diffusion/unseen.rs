@@ -45,39 +45,49 @@ pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<Option<F
     Ok(Some(loaded))
 }
 
-/// Gives a fine-tune in `out` the unseen-skeleton denoiser of the model it starts from (`None`:
-/// the built-in one), when that model has one: a model tuned on one creature then samples every
+/// The unseen-skeleton denoiser a fine-tune takes from the model it starts from, read and
+/// checked before any training, so that a denoiser sampling would refuse stops the run before it
+/// writes anything. Why a fine-tune takes it: a model tuned on one creature then samples every
 /// other skeleton as its starting model did, instead of with a main denoiser that never trained
-/// under the fallback statistics (it stands them still). Only what sampling reads is written
-/// (weights and `checkpoint.json`), checked as sampling checks it, into a temporary folder moved
-/// into place. Returns whether `out/unseen` was written; an existing one is left alone.
-pub fn carry(init: Option<&Path>, out: &Path) -> Result<bool, CheckpointError> {
-    let target = out.join(UNSEEN_DIR);
-    if target.exists() {
-        return Ok(false);
-    }
-    let (info, weights) = match init {
-        None => (BUILTIN_INFO.to_vec(), BUILTIN_WEIGHTS.to_vec()),
-        Some(dir) => {
-            if !dir.join(UNSEEN_DIR).is_dir() {
-                return Ok(false);
+/// under the fallback statistics (it stands them still).
+pub struct Carried {
+    info: Vec<u8>,
+    weights: Vec<u8>,
+}
+
+impl Carried {
+    /// The denoiser of the model at `init` (`None`: the built-in one), if it has one.
+    pub fn from(init: Option<&Path>) -> Result<Option<Carried>, CheckpointError> {
+        match init {
+            None => Ok(Some(Carried { info: BUILTIN_INFO.to_vec(), weights: BUILTIN_WEIGHTS.to_vec() })),
+            Some(dir) if dir.join(UNSEEN_DIR).is_dir() => {
+                // The same check sampling makes.
+                frozen_or_default(init, &Device::Cpu)?;
+                let (info, weights) = checkpoint::read_dir_files(&dir.join(UNSEEN_DIR))?;
+                Ok(Some(Carried { info, weights }))
             }
-            checkpoint::read_dir_files(&dir.join(UNSEEN_DIR))?
+            Some(_) => Ok(None),
         }
-    };
-    if init.is_some() {
-        // The same check sampling makes, so a fine-tune never carries a denoiser it would refuse.
-        frozen_or_default(init, &Device::Cpu)?;
     }
-    let temporary = out.join(format!(".{UNSEEN_DIR}.partial"));
-    let _ = std::fs::remove_dir_all(&temporary);
-    std::fs::create_dir_all(&temporary).map_err(CheckpointError::io(format!("cannot create {}", temporary.display())))?;
-    std::fs::write(temporary.join("checkpoint.json"), &info)
-        .map_err(CheckpointError::io(format!("cannot write {}", temporary.join("checkpoint.json").display())))?;
-    std::fs::write(temporary.join("model.safetensors"), &weights)
-        .map_err(CheckpointError::io(format!("cannot write {}", temporary.join("model.safetensors").display())))?;
-    std::fs::rename(&temporary, &target).map_err(CheckpointError::io(format!("cannot move {} into place", target.display())))?;
-    Ok(true)
+
+    /// Writes it to `out/unseen` (only what sampling reads: `checkpoint.json` and the weights),
+    /// through a temporary folder moved into place. Returns whether it was written; an existing
+    /// `out/unseen` is left alone.
+    pub fn write(&self, out: &Path) -> Result<bool, CheckpointError> {
+        let target = out.join(UNSEEN_DIR);
+        if target.exists() {
+            return Ok(false);
+        }
+        let temporary = out.join(format!(".{UNSEEN_DIR}.partial"));
+        let _ = std::fs::remove_dir_all(&temporary);
+        std::fs::create_dir_all(&temporary).map_err(CheckpointError::io(format!("cannot create {}", temporary.display())))?;
+        for (name, bytes) in [("checkpoint.json", &self.info), ("model.safetensors", &self.weights)] {
+            let path = temporary.join(name);
+            std::fs::write(&path, bytes).map_err(CheckpointError::io(format!("cannot write {}", path.display())))?;
+        }
+        std::fs::rename(&temporary, &target).map_err(CheckpointError::io(format!("cannot move {} into place", target.display())))?;
+        Ok(true)
+    }
 }
 
 /// Why `info` cannot serve skeletons a model was not trained on, if it cannot.

@@ -140,6 +140,15 @@ fn a_fine_tune_carries_its_models_unseen_denoiser() {
     let from_plain = dir.join("from-plain");
     let said = tune(&plain, &example("bird.bvh"), &from_plain);
     assert!(!from_plain.join("unseen").exists() && !said.contains("carried"), "{said}");
+    // One whose unseen/ sampling would refuse stops the fine-tune before it writes anything.
+    std::fs::create_dir_all(plain.join("unseen")).unwrap();
+    for f in ["checkpoint.json", "model.safetensors"] {
+        std::fs::copy(plain.join(f), plain.join("unseen").join(f)).unwrap();
+    }
+    let refused = dir.join("refused");
+    let out = run("mo-train", &[s(&example("bird.bvh")), "--init", s(&plain), "--out", s(&refused), "--steps", "1"], None);
+    check_failure("mo-train", "--init with a refused unseen/", &out, "--fallback-stats all");
+    assert!(!refused.exists(), "no partial output");
 }
 
 /// A trained skeleton samples the same from any of its clips: the rest pose (rig and P_S) is
