@@ -25,11 +25,7 @@ impl Known {
     /// built-in's), judged by `UNSEEN_LIMIT`: what `mo-sample` samples a skeleton the main
     /// denoiser was not trained on with.
     pub fn unseen_denoiser(dir: Option<&Path>, info: &CheckpointInfo) -> anyhow::Result<Known> {
-        let model = dir.map_or_else(
-            || crate::diffusion::unseen::BUILTIN_NAME.to_string(),
-            |d| format!("model {}", d.join(crate::diffusion::unseen::UNSEEN_DIR).display()),
-        );
-        Ok(Known { reference: info.ood_reference()?.with_limit(UNSEEN_LIMIT), model })
+        Ok(Known { reference: info.ood_reference()?.with_limit(UNSEEN_LIMIT), model: crate::diffusion::unseen::label(dir) })
     }
 
     /// The latent model's training skeletons (its `rigs.json`).

@@ -27,22 +27,32 @@ const BUILTIN_WEIGHTS: &[u8] = include_bytes!("../../models/zoo-compact/unseen/m
 /// How messages name the built-in model's unseen-skeleton denoiser.
 pub const BUILTIN_NAME: &str = "the built-in default model's unseen-skeleton denoiser";
 
+/// How messages name the unseen-skeleton denoiser of the model at `dir` (the built-in's when
+/// `None`).
+pub fn label(dir: Option<&Path>) -> String {
+    dir.map_or_else(|| BUILTIN_NAME.to_string(), |d| format!("model {}", d.join(UNSEEN_DIR).display()))
+}
+
 /// The denoiser for skeletons the model at `dir` (the built-in one when `None`) was not trained
 /// on: `dir/unseen` when it exists (`None` when it does not), checked to have trained under the
 /// fallback statistics it will sample with.
 pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<Option<FrozenDenoiser>, CheckpointError> {
-    let (loaded, name) = match dir {
-        Some(dir) => {
-            let unseen = dir.join(UNSEEN_DIR);
-            if !unseen.is_dir() {
-                return Ok(None);
-            }
-            (checkpoint::frozen(&unseen, device)?, format!("model {}", unseen.display()))
+    match dir {
+        Some(d) if !d.join(UNSEEN_DIR).is_dir() => Ok(None),
+        Some(d) => {
+            let (info, weights) = checkpoint::read_dir_files(&d.join(UNSEEN_DIR))?;
+            checked(&info, &weights, dir, device).map(Some)
         }
-        None => (checkpoint::frozen_bytes(BUILTIN_INFO, BUILTIN_WEIGHTS, device).map_err(CheckpointError::of(BUILTIN_NAME.into()))?, BUILTIN_NAME.to_string()),
-    };
-    check(&loaded.info).map_err(|why| CheckpointError::of(name)(CheckpointError::Invalid(why)))?;
-    Ok(Some(loaded))
+        None => checked(BUILTIN_INFO, BUILTIN_WEIGHTS, None, device).map(Some),
+    }
+}
+
+/// The denoiser from its files' bytes, refused (naming it, `label(dir)`) unless it can serve
+/// skeletons its model was not trained on.
+fn checked(info: &[u8], weights: &[u8], dir: Option<&Path>, device: &Device) -> Result<FrozenDenoiser, CheckpointError> {
+    let loaded = checkpoint::frozen_bytes(info, weights, device).map_err(CheckpointError::of(label(dir)))?;
+    check(&loaded.info).map_err(|why| CheckpointError::of(label(dir))(CheckpointError::Invalid(why)))?;
+    Ok(loaded)
 }
 
 /// The unseen-skeleton denoiser a fine-tune takes from the model it starts from, read and
@@ -61,9 +71,9 @@ impl Carried {
         match init {
             None => Ok(Some(Carried { info: BUILTIN_INFO.to_vec(), weights: BUILTIN_WEIGHTS.to_vec() })),
             Some(dir) if dir.join(UNSEEN_DIR).is_dir() => {
-                // The same check sampling makes.
-                frozen_or_default(init, &Device::Cpu)?;
                 let (info, weights) = checkpoint::read_dir_files(&dir.join(UNSEEN_DIR))?;
+                // The same check sampling makes, on the bytes that will be written.
+                checked(&info, &weights, init, &Device::Cpu)?;
                 Ok(Some(Carried { info, weights }))
             }
             Some(_) => Ok(None),
