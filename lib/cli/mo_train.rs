@@ -5,6 +5,7 @@ use crate::cli::load::{expand_inputs, load_motions, LoadOptions};
 use crate::cli::{CommonOpts, Exit};
 use crate::diffusion::data::{Augmentation, FallbackStats, LossUnits, TrainSet};
 use crate::diffusion::rest_norm::{RestNorm, RestToken, RestTokens};
+use crate::diffusion::start::init_dir;
 use crate::diffusion::trainer::{refuse_existing, train_loop, AnyTopOptions, AnyTopStart, AnyTopTrainer, LoopOptions, StopFlag, TrainError, Trainer};
 use crate::diffusion::unseen;
 use crate::embed::NameTable;
@@ -389,7 +390,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
     refuse_to_overwrite(args)?;
     // A fine-tune samples other skeletons as the model it starts from did (`unseen::Carried`);
     // one sampling would refuse stops the run here, before any message or output.
-    let init = args.init.as_deref().filter(|dir| dir.as_os_str() != "builtin");
+    let init = args.init.as_deref().and_then(init_dir);
     let carried = if args.init.is_some() && !args.resume { unseen::Carried::from(init)? } else { None };
     // The checkpoint first: a resumed run must rebuild the data (augmented variants
     // included) from the seed the run started with.

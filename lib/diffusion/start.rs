@@ -7,6 +7,14 @@ use super::trainer::{AnyTopInit, AnyTopOptions, AnyTopResume, AnyTopStart, Train
 use candle_core::Device;
 use std::path::Path;
 
+/// What `--init` names the model inside the binaries by (a directory of that name is `./builtin`).
+pub const BUILTIN_INIT: &str = "builtin";
+
+/// The model directory an `--init` value names, or None for the built-in model.
+pub fn init_dir(init: &Path) -> Option<&Path> {
+    (init.as_os_str() != BUILTIN_INIT).then_some(init)
+}
+
 impl AnyTopStart {
     /// Resume the checkpoint in `out` when `resume` (its optimiser at learning rate `lr`), else
     /// fine-tune `init` (`builtin`, the model inside the binaries, or a model directory), else
@@ -41,7 +49,10 @@ impl AnyTopStart {
             return Ok((AnyTopStart::Resume(resume), notes));
         }
         if let Some(init) = init {
-            let init = if init.as_os_str() == "builtin" { AnyTopInit::builtin(device)? } else { AnyTopInit::load(init, device)? };
+            let init = match init_dir(init) {
+                None => AnyTopInit::builtin(device)?,
+                Some(dir) => AnyTopInit::load(dir, device)?,
+            };
             notes.push(format!("fine-tuning {} (its size and noise schedule; --preset is not used)", init.source()));
             return Ok((AnyTopStart::Init(init), notes));
         }
