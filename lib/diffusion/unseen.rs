@@ -38,13 +38,18 @@ pub fn label(dir: Option<&Path>) -> String {
 /// fallback statistics it will sample with.
 pub fn frozen_or_default(dir: Option<&Path>, device: &Device) -> Result<Option<FrozenDenoiser>, CheckpointError> {
     match dir {
-        Some(d) if !d.join(UNSEEN_DIR).is_dir() => Ok(None),
-        Some(d) => {
-            let (info, weights) = checkpoint::read_dir_files(&d.join(UNSEEN_DIR))?;
-            checked(&info, &weights, dir, device).map(Some)
-        }
+        Some(d) => read(d)?.map(|(info, weights)| checked(&info, &weights, dir, device)).transpose(),
         None => checked(BUILTIN_INFO, BUILTIN_WEIGHTS, None, device).map(Some),
     }
+}
+
+/// The bytes of `dir/unseen`'s `checkpoint.json` and weights, when the folder exists.
+fn read(dir: &Path) -> Result<Option<(Vec<u8>, Vec<u8>)>, CheckpointError> {
+    let unseen = dir.join(UNSEEN_DIR);
+    if !unseen.is_dir() {
+        return Ok(None);
+    }
+    checkpoint::read_dir_files(&unseen).map(Some)
 }
 
 /// The denoiser from its files' bytes, refused (naming it, `label(dir)`) unless it can serve
@@ -70,13 +75,12 @@ impl Carried {
     pub fn from(init: Option<&Path>) -> Result<Option<Carried>, CheckpointError> {
         match init {
             None => Ok(Some(Carried { info: BUILTIN_INFO.to_vec(), weights: BUILTIN_WEIGHTS.to_vec() })),
-            Some(dir) if dir.join(UNSEEN_DIR).is_dir() => {
-                let (info, weights) = checkpoint::read_dir_files(&dir.join(UNSEEN_DIR))?;
+            Some(dir) => {
+                let Some((info, weights)) = read(dir)? else { return Ok(None) };
                 // The same check sampling makes, on the bytes that will be written.
                 checked(&info, &weights, init, &Device::Cpu)?;
                 Ok(Some(Carried { info, weights }))
             }
-            Some(_) => Ok(None),
         }
     }
 
