@@ -295,6 +295,9 @@ impl Previous {
 /// The settings whose defaults depend on other flags: given, else the resumed checkpoint's,
 /// else a fine-tune's, else a new run's.
 struct Resolved {
+    /// `--init` without `--resume`: a new run from a model's weights (a resumed fine-tune is
+    /// an ordinary resume).
+    fine_tune: bool,
     lr: f64,
     augment: f64,
     fallback_stats: FallbackStats,
@@ -313,6 +316,7 @@ impl Resolved {
         let previous = if args.resume { Previous::read(&args.out) } else { None };
         let pick = |given: Option<f64>, from: Option<f64>, init: f64, new: f64| given.or(from).unwrap_or(if fine_tune { init } else { new });
         Resolved {
+            fine_tune,
             lr: pick(args.lr, previous.as_ref().map(|p| p.lr), INIT_LR, 1e-4),
             augment: pick(args.augment, previous.as_ref().map(|p| p.augment), 0.0, 2.0 / 3.0),
             fallback_stats: args.fallback_stats.or(previous.as_ref().map(|p| p.fallback_stats)).unwrap_or_default(),
@@ -391,7 +395,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
     // A fine-tune samples other skeletons as the model it starts from did (`unseen::Carried`);
     // one sampling would refuse stops the run here, before any message or output.
     let init = args.init.as_deref().and_then(init_dir);
-    let carried = if args.init.is_some() && !args.resume { unseen::Carried::from(init)? } else { None };
+    let carried = if resolved.fine_tune { unseen::Carried::from(init)? } else { None };
     // The checkpoint first: a resumed run must rebuild the data (augmented variants
     // included) from the seed the run started with.
     let (start, notes) = AnyTopStart::choose(&args.out, args.resume, args.init.as_deref(), resolved.lr, &opts, device)?;
