@@ -118,6 +118,15 @@ fn a_fine_tune_carries_its_models_unseen_denoiser() {
         assert!(carried == std::fs::read(root.join("models/zoo-compact/unseen").join(f)).unwrap(), "unseen/{f} is not the built-in's");
     }
     assert!(!from_builtin.join(".unseen.partial").exists(), "the temporary folder is left behind");
+    // Resuming the fine-tune (--init kept on the command line) is a resume: nothing is carried
+    // again, and the carried folder stays as it was.
+    let resumed = run("mo-train", &[s(&example("quadruped.bvh")), "--init", "builtin", "--out", s(&from_builtin), "--steps", "2", "--resume"], None);
+    ok(&resumed, "resumed fine-tune");
+    assert!(!String::from_utf8_lossy(&resumed.stderr).contains("carried"), "{}", String::from_utf8_lossy(&resumed.stderr));
+    assert!(
+        std::fs::read(from_builtin.join("unseen/model.safetensors")).unwrap()
+            == std::fs::read(root.join("models/zoo-compact/unseen/model.safetensors")).unwrap()
+    );
     // A skeleton neither the built-in nor the tuned model trained on (an augmented crab) samples
     // from the tuned model as from the built-in: both through the built-in's unseen denoiser.
     let crab = dir.join("crab_aug.bvh");
