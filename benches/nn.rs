@@ -1,7 +1,8 @@
 //! Denoiser speed on CPU: `cargo bench --bench nn`.
 //!
 //! 1. Raw candle f32 matmul throughput (n x n), the peak the model FLOP utilisation is measured
-//!    against. Cargo.toml enables gemm's `x86-v4` feature for this.
+//!    against, and at the shapes the compact preset's training step multiplies (thin: an inner
+//!    or outer dimension of 64-192). Cargo.toml enables gemm's `x86-v4` feature for this.
 //! 2. For the `tiny`, `small` and `paper` presets: forward, and forward + backward (one training
 //!    step without the optimiser), on a batch of 8 random skeletons with 25..60 joints (padded
 //!    to 60) and 40 frames (41 tokens with P_S). GFLOP/s counts the matmul FLOPs of the model
@@ -29,14 +30,20 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 fn matmul_gflops(n: usize) -> f64 {
+    shaped_gflops(n, n, n, false)
+}
+
+/// GFLOP/s of an (m x k) by (k x n) f32 matmul; `a_transposed`: a is the transpose of a
+/// contiguous (k x m) tensor, as in a linear layer's weight gradient dW = dYᵀ X.
+fn shaped_gflops(m: usize, k: usize, n: usize, a_transposed: bool) -> f64 {
     let dev = Device::Cpu;
-    let a = Tensor::ones((n, n), DType::F32, &dev).unwrap();
-    let b = Tensor::ones((n, n), DType::F32, &dev).unwrap();
+    let a = if a_transposed { Tensor::ones((k, m), DType::F32, &dev).unwrap().t().unwrap() } else { Tensor::ones((m, k), DType::F32, &dev).unwrap() };
+    let b = Tensor::ones((k, n), DType::F32, &dev).unwrap();
     let _ = a.matmul(&b).unwrap();
     let t = median(&time_runs(|| {
         black_box(a.matmul(&b).unwrap());
     }));
-    2.0 * (n as f64).powi(3) / t.as_secs_f64() / 1e9
+    2.0 * (m * k * n) as f64 / t.as_secs_f64() / 1e9
 }
 
 struct Clip {
@@ -86,6 +93,24 @@ fn main() {
         let g = matmul_gflops(n);
         peak = peak.max(g);
         println!("| {n} | {g:.1} |");
+    }
+    println!();
+    // The products a training step of the compact preset (width 64, feed-forward 128) makes, on
+    // one sub-batch of a zoo quadruped (4 crops x 41 tokens x 26 joints = 4,264 rows): how near
+    // they run to the square peak bounds what a faster matmul could give a step.
+    let rows = 4 * 41 * 26;
+    println!("| model-shaped matmul, {rows} rows | m x k x n | GFLOP/s |");
+    println!("|---|---|---|");
+    for (what, m, k, n, t) in [
+        ("q, k, v projection", rows, 64, 192, false),
+        ("attention output", rows, 64, 64, false),
+        ("feed-forward up", rows, 64, 128, false),
+        ("feed-forward down", rows, 128, 64, false),
+        ("q, k, v input gradient", rows, 192, 64, false),
+        ("q, k, v weight gradient", 192, rows, 64, true),
+        ("feed-forward down weight gradient", 64, rows, 128, true),
+    ] {
+        println!("| {what} | {m} x {k} x {n} | {:.1} |", shaped_gflops(m, k, n, t));
     }
     println!();
 
