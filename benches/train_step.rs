@@ -124,6 +124,7 @@ fn main() {
         crop,
         lambda_geo: 1.0,
         lambda_vel: 0.0,
+        lambda_foot: 0.0,
         ema: 0.999,
         noise_shift: None,
         position_jitter: None,

@@ -136,6 +136,12 @@ pub struct Args {
     /// reference). 0 = off. Not kept in the checkpoint: give it again with --resume.
     #[arg(long, value_name = "W", default_value_t = 0.0, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
     pub lambda_vel: f64,
+    /// Weight of a foot-slide loss next to the MSE: where a clip's foot is planted (its contact
+    /// channel), how far the prediction's positions and root move that joint from frame to
+    /// frame against how far the clip's joint moves, in the clip's velocity spreads. 0 = off.
+    /// Not kept in the checkpoint: give it again with --resume.
+    #[arg(long, value_name = "W", default_value_t = 0.0, value_parser = bounds::non_negative(bounds::MAX_WEIGHT))]
+    pub lambda_foot: f64,
     /// Chance that a training draw uses an augmented skeleton (joints removed or added), as a
     /// number in [0, 1] or a fraction like 2/3 [default: 2/3; with --init 0].
     #[arg(long, value_name = "P", value_parser = parse_probability)]
@@ -379,6 +385,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         crop: resolved.crop.unwrap_or(40) as usize,
         lambda_geo: args.lambda_geo,
         lambda_vel: args.lambda_vel,
+        lambda_foot: args.lambda_foot,
         augment: resolved.augment,
         augment_variants: args.augment_variants as usize,
         fallback_stats: resolved.fallback_stats,

@@ -11,6 +11,7 @@
 use super::data::{Crop, TrainSet};
 use super::schedule::Schedule;
 use crate::nn::{batch_from, BatchItem, Denoiser, NnError};
+use crate::repr::anytop::{DIMS_ROTATION, DIMS_VELOCITY, DIM_CONTACT};
 use crate::rng::{gaussian, SplitMix64};
 use candle_core::backprop::GradStore;
 use candle_core::cpu_backend::unary_map;
@@ -208,12 +209,14 @@ pub struct StepStats {
 pub struct LossTerms {
     pub geo: f64,
     pub vel: f64,
+    /// Weight of the foot-slide term (`foot_slide_sum`).
+    pub foot: f64,
     pub weighting: Weighting,
 }
 
 impl LossTerms {
     /// The reference's: MSE + 1 × rotation, every diffusion step alike.
-    pub const REFERENCE: LossTerms = LossTerms { geo: 1.0, vel: 0.0, weighting: Weighting::X0 };
+    pub const REFERENCE: LossTerms = LossTerms { geo: 1.0, vel: 0.0, foot: 0.0, weighting: Weighting::X0 };
 }
 
 /// How much a crop's error counts, by the diffusion step it was noised to. The model predicts
@@ -444,6 +447,10 @@ pub fn training_loss(
                     (Some((a, n)), Some((b, m))) => Some(((a + b)?, n + m)),
                     _ => None,
                 },
+                foot: match (t.foot, part.foot) {
+                    (Some(a), Some(b)) => Some((a + b)?),
+                    _ => None,
+                },
             },
         });
     }
@@ -454,6 +461,9 @@ pub fn training_loss(
     }
     if let Some((velocity, values)) = sums.velocity.filter(|_| terms.vel != 0.0) {
         loss = (&loss + ((velocity / values.max(1.0))? * terms.vel)?)?;
+    }
+    if let Some(foot) = sums.foot {
+        loss = (&loss + ((foot / sums.tokens.max(1.0))? * terms.foot)?)?;
     }
     Ok(loss)
 }
@@ -488,6 +498,10 @@ pub fn step_gradients(
         }
         if let (Some((velocity, _)), Some(count)) = (sums.velocity, velocity_values) {
             loss = (&loss + ((velocity / count.max(1.0))? * terms.vel)?)?;
+        }
+        // Over the batch's tokens, as the rotation term: the draw knows them before any pass.
+        if let Some(foot) = sums.foot {
+            loss = (&loss + ((foot / draw.tokens.max(1.0))? * terms.foot)?)?;
         }
         let value = loss.to_scalar::<f32>()? as f64;
         Ok((value, loss.backward()?))
@@ -544,6 +558,8 @@ struct LossSums {
     tokens: f64,
     /// Summed squared error of frame-to-frame changes and the number of values it covers.
     velocity: Option<(Tensor, f64)>,
+    /// Summed foot-slide error (`foot_slide_sum`), when asked for.
+    foot: Option<Tensor>,
 }
 
 fn loss_sums(
@@ -638,8 +654,21 @@ fn loss_sums(
     } else {
         None
     };
+    let foot = if terms.foot != 0.0 && t > 2 {
+        let (mean, std) = physical_stats(set, crops, j, d, device)?;
+        let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.broadcast_mul(&std)?.broadcast_add(&mean) };
+        let clean_physical = physical(&clean.x)?;
+        let velocity_std = std.narrow(3, DIMS_VELOCITY.start, 3)?;
+        let pair_mask = (mask.narrow(1, 2, t - 2)? * mask.narrow(1, 1, t - 2)?)?;
+        let error = foot_slide_error(&physical(&predicted)?, &clean_physical, &velocity_std)?;
+        // Only where the clip's own foot is planted (the contact channel, 0 or 1 in physical units).
+        let contact = clean_physical.narrow(1, 1, t - 2)?.narrow(3, DIM_CONTACT, 1)?.ge(0.5)?.to_dtype(DType::F32)?;
+        Some(weighed(error.broadcast_mul(&contact)?.broadcast_mul(&pair_mask)?)?.sum_all()?)
+    } else {
+        None
+    };
     if terms.geo == 0.0 {
-        return Ok(LossSums { squared, values, rotation: None, tokens, velocity });
+        return Ok(LossSums { squared, values, rotation: None, tokens, velocity, foot });
     }
     // The rotation term needs the 6D values in physical units: undo each skeleton's
     // normalisation (padded joints get mean 0, std 1; they are masked anyway).
@@ -658,7 +687,67 @@ fn loss_sums(
     let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(3, 3, 6)?.broadcast_mul(&std)?.broadcast_add(&mean) };
     let geo = rotation_distance(&physical(&predicted)?, &physical(&clean.x)?)?;
     let rotation = weighed(geo.unsqueeze(3)?.broadcast_mul(&mask)?)?.sum_all()?;
-    Ok(LossSums { squared, values, rotation: Some(rotation), tokens, velocity })
+    Ok(LossSums { squared, values, rotation: Some(rotation), tokens, velocity, foot })
+}
+
+/// Each crop's per-joint means and spreads (`STD_EPSILON` added), `(b, 1, j, d)`; padded
+/// joints get mean 0, spread 1 (they are masked anyway).
+fn physical_stats(set: &TrainSet, crops: &[Crop], j: usize, d: usize, device: &Device) -> candle_core::Result<(Tensor, Tensor)> {
+    let b = crops.len();
+    let (mut mean, mut std) = (vec![0f32; b * j * d], vec![1f32; b * j * d]);
+    for (i, c) in crops.iter().enumerate() {
+        let sk = set.data(c);
+        let n = sk.skeleton.len() * d;
+        mean[i * j * d..i * j * d + n].copy_from_slice(&sk.stats.mean[..n]);
+        for (o, &v) in std[i * j * d..i * j * d + n].iter_mut().zip(&sk.stats.std[..n]) {
+            *o = v + crate::repr::anytop::STD_EPSILON;
+        }
+    }
+    Ok((Tensor::from_vec(mean, (b, 1, j, d), device)?, Tensor::from_vec(std, (b, 1, j, d), device)?))
+}
+
+/// Where each joint goes from frame k to k + 1 (k = 1 .. t − 2; token 0 is the rest pose) as
+/// the prediction's positions and root imply it, against where the clip's joint goes
+/// (its velocity channels), in the clip's velocity spreads, squared and summed over x, y, z:
+/// `(b, t − 2, j, 1)`, in physical units in, nothing masked.
+///
+/// Why: the decoder places a joint by its RIC position turned back by the root's facing, on a
+/// root moved by the root's velocity channels (`recover`). The model predicts those
+/// separately, so a foot can be planted in the clip and slide in the sample when the legs and
+/// the root disagree (issue 22: 91% of the sampled near-ground steps had the contact channel on
+/// and still slid). The displacement in frame k + 1's facing is
+/// `p[k+1] − R(θ[k+1] − θ[k]) p[k] + (v_root.x, 0, v_root.z)[k]`, which for the clip itself is
+/// exactly its velocity channels; AnyTop's own foot term (off by default) compares only the
+/// RIC positions, which move with the root.
+pub fn foot_slide_error(predicted: &Tensor, clean: &Tensor, velocity_std: &Tensor) -> candle_core::Result<Tensor> {
+    let t = predicted.dim(1)?;
+    let dims = |x: &Tensor, start: usize, n: usize| x.narrow(3, start, n);
+    // Facing as (cos θ, sin θ): the root's 6D holds R_y(θ)'s first column (cos θ, 0, −sin θ).
+    let root = predicted.narrow(2, 0, 1)?;
+    let (a, z) = (dims(&root, DIMS_ROTATION.start, 1)?, dims(&root, DIMS_ROTATION.start + 2, 1)?);
+    let norm = (a.sqr()?.add(&z.sqr()?)? + 1e-8)?.sqrt()?;
+    let (cos, sin) = (a.div(&norm)?, z.neg()?.div(&norm)?);
+    let (c0, s0, c1, s1) = (cos.narrow(1, 1, t - 2)?, sin.narrow(1, 1, t - 2)?, cos.narrow(1, 2, t - 2)?, sin.narrow(1, 2, t - 2)?);
+    // R(θ1 − θ0) acting on (x, z): x' = c x + s z, z' = −s x + c z.
+    let c = ((&c1 * &c0)? + (&s1 * &s0)?)?;
+    let s = ((&s1 * &c0)? - (&c1 * &s0)?)?;
+    let p0 = predicted.narrow(1, 1, t - 2)?;
+    let p1 = predicted.narrow(1, 2, t - 2)?;
+    let (x0, y0, z0) = (dims(&p0, 0, 1)?, dims(&p0, 1, 1)?, dims(&p0, 2, 1)?);
+    let root_velocity = root.narrow(1, 1, t - 2)?;
+    let (vx, vz) = (dims(&root_velocity, DIMS_VELOCITY.start, 1)?, dims(&root_velocity, DIMS_VELOCITY.start + 2, 1)?);
+    let turned_x = (c.broadcast_mul(&x0)? + s.broadcast_mul(&z0)?)?;
+    let turned_z = (c.broadcast_mul(&z0)? - s.broadcast_mul(&x0)?)?;
+    let moved = Tensor::cat(
+        &[
+            dims(&p1, 0, 1)?.sub(&turned_x)?.broadcast_add(&vx)?,
+            (dims(&p1, 1, 1)? - y0)?,
+            dims(&p1, 2, 1)?.sub(&turned_z)?.broadcast_add(&vz)?,
+        ],
+        3,
+    )?;
+    let target = dims(&clean.narrow(1, 1, t - 2)?, DIMS_VELOCITY.start, 3)?;
+    (moved - target)?.broadcast_div(velocity_std)?.sqr()?.sum_keepdim(3)
 }
 
 /// One training step: `draw_step`, `step_gradients` (the groups in parallel on the current
@@ -865,7 +954,7 @@ mod tests {
                             &mut rng,
                             6,
                             12,
-                            LossTerms { geo: 1.0, vel: 0.5, weighting: Weighting::MinSnr(5.0) },
+                            LossTerms { geo: 1.0, vel: 0.5, foot: 1.0, weighting: Weighting::MinSnr(5.0) },
                             &dev,
                         )
                         .unwrap()
@@ -893,8 +982,8 @@ mod tests {
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
         let vars = named_vars(&varmap);
         let schedule = Schedule::cosine(100);
-        for (geo, vel, weighting) in [(1.0, 0.0, Weighting::X0), (1.0, 1.0, Weighting::V), (0.0, 0.5, Weighting::MinSnr(5.0))] {
-            let terms = LossTerms { geo, vel, weighting };
+        for (geo, vel, foot, weighting) in [(1.0, 0.0, 0.0, Weighting::X0), (1.0, 1.0, 2.0, Weighting::V), (0.0, 0.5, 1.0, Weighting::MinSnr(5.0))] {
+            let terms = LossTerms { geo, vel, foot, weighting };
             let reference = training_loss(&model, &set, &schedule, &mut SplitMix64::new(9), 6, 12, terms, &dev).unwrap();
             let want = reference.backward().unwrap();
             let draw = draw_step(&set, &schedule, &mut SplitMix64::new(9), 6, 12).unwrap();
@@ -970,7 +1059,7 @@ mod tests {
         let dev = Device::Cpu;
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 6, &dev), &DenoiserConfig::tiny()).unwrap();
-        let terms = LossTerms { geo: 1.0, vel: 0.0, weighting: Weighting::V };
+        let terms = LossTerms { geo: 1.0, vel: 0.0, foot: 0.0, weighting: Weighting::V };
         let at_zero = step_gradients(&model, &set, &schedule, &draw, terms, &dev).unwrap().0;
         assert_eq!(step_gradients(&model, &set, &schedule, &draw, terms, &dev).unwrap().0, at_zero, "the loss of a draw is repeatable");
         draw.groups.iter_mut().flat_map(|g| g.crops.iter_mut()).for_each(|c| c.position = 300);
@@ -1003,7 +1092,7 @@ mod tests {
         let dev = Device::Cpu;
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 6, &dev), &DenoiserConfig::tiny()).unwrap();
-        let terms = LossTerms { geo: 1.0, vel: 0.5, weighting: Weighting::V };
+        let terms = LossTerms { geo: 1.0, vel: 0.5, foot: 0.0, weighting: Weighting::V };
         let (a, ga) = step_gradients(&model, &set, &schedule, &whole, terms, &dev).unwrap();
         let (b, gb) = step_gradients(&model, &set, &schedule, &parts, terms, &dev).unwrap();
         // f32 sums in another order: rounding only.
@@ -1074,6 +1163,46 @@ mod tests {
                 assert_eq!(bits(var.as_tensor()), bits(&w), "parameters, decay {decay}, step {}", opt.step);
                 let state = opt.state().unwrap();
                 assert_eq!((bits(&state["m.w"]), bits(&state["v.w"])), (bits(&m), bits(&v)), "moments, step {}", opt.step);
+            }
+        }
+    }
+
+    /// The clip's own features move every joint exactly as its velocity channels say (the
+    /// encoder's definition), on a creature that turns; a joint pushed off in one frame does not.
+    #[test]
+    fn foot_slide_error_is_zero_on_the_clip_itself() {
+        use crate::document::AnyTopSection;
+        use crate::repr::anytop::RigOptions;
+        let dev = Device::Cpu;
+        for name in ["quadruped", "snake", "biped"] {
+            let (skeleton, mut motion) = crate::synth::creature(name, 0).unwrap();
+            // Turn the whole creature about the vertical, faster and faster, so the facing changes.
+            let n = motion.joints;
+            for f in 0..motion.frames {
+                let turn = glam::DQuat::from_rotation_y(0.0004 * (f * f) as f64);
+                motion.rotations[f * n] = turn * motion.rotations[f * n];
+                motion.translations[f * n] = turn * motion.translations[f * n];
+            }
+            let section = AnyTopSection::new(&skeleton, &motion.first_frames(2), &RigOptions::default()).unwrap();
+            let f = section.rig.encode(&skeleton, &motion).unwrap().features;
+            let (t, j, d) = (f.frames.min(60), f.joints, f.dims);
+            let mut data = f.data[..t * j * d].to_vec();
+            let x = Tensor::from_vec(data.clone(), (1, t, j, d), &dev).unwrap();
+            let ones = Tensor::ones((1, 1, j, 3), DType::F32, &dev).unwrap();
+            let e = foot_slide_error(&x, &x, &ones).unwrap().flatten_all().unwrap().to_vec1::<f32>().unwrap();
+            // Some root turning is in the crop, so a wrong sign of the turn would show.
+            let turn = (1..t).map(|k| (f.at(k, 0)[3] - f.at(k - 1, 0)[3]).abs()).fold(0f32, f32::max);
+            assert!(turn > 1e-3, "{name}: the crop should turn (max change of cos {turn})");
+            let worst = e.iter().cloned().fold(0f32, f32::max);
+            assert!(worst < 1e-8, "{name}: the clip's own joints should move as their velocities say, worst {worst}");
+            // Frame 10's last joint pushed 0.1 along x: pairs (9, 10) and (10, 11) are off.
+            data[(10 * j + j - 1) * d] += 0.1;
+            let pushed = Tensor::from_vec(data, (1, t, j, d), &dev).unwrap();
+            let e = foot_slide_error(&pushed, &x, &ones).unwrap().flatten_all().unwrap().to_vec1::<f32>().unwrap();
+            // Row k of the error is the pair (k + 1, k + 2).
+            for (k, &v) in e.chunks(j).map(|r| &r[j - 1]).enumerate() {
+                let expected = if k + 1 == 9 || k + 1 == 10 { 0.01 } else { 0.0 };
+                assert!((v - expected).abs() < 2e-3, "{name}: pair {} of the pushed joint: {v}, expected about {expected}", k + 1);
             }
         }
     }
@@ -1152,7 +1281,7 @@ mod tests {
             &mut SplitMix64::new(9),
             3,
             12,
-            LossTerms { geo: 1.0, vel: 1.0, weighting: Weighting::X0 },
+            LossTerms { geo: 1.0, vel: 1.0, foot: 0.0, weighting: Weighting::X0 },
             &dev,
         )
         .unwrap();
@@ -1173,7 +1302,7 @@ mod tests {
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
         let (mut set, schedule) = one_quadruped();
         let loss = |set: &TrainSet, geo: f64| {
-            let terms = LossTerms { geo, vel: 0.5, weighting: Weighting::V };
+            let terms = LossTerms { geo, vel: 0.5, foot: 0.0, weighting: Weighting::V };
             training_loss(&model, set, &schedule, &mut SplitMix64::new(9), 3, 12, terms, &dev).unwrap().to_scalar::<f32>().unwrap() as f64
         };
         let (plain, plain_geo) = (loss(&set, 0.0), loss(&set, 1.0));
@@ -1198,13 +1327,31 @@ mod tests {
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
         let loss = |vel: f64| {
-            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, LossTerms { geo: 1.0, vel, weighting: Weighting::X0 }, &dev)
+            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, LossTerms { geo: 1.0, vel, foot: 0.0, weighting: Weighting::X0 }, &dev)
                 .unwrap()
                 .to_scalar::<f32>()
                 .unwrap() as f64
         };
         let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
         // Same draws, so the term is linear in its weight; an untrained model's changes are off.
+        assert!(one > off, "{one} vs {off}");
+        assert!(((two - off) - 2.0 * (one - off)).abs() < 1e-4 * two.abs().max(1.0), "{off} {one} {two}");
+    }
+
+    #[test]
+    fn the_foot_loss_adds_the_slide_of_planted_joints() {
+        let dev = Device::Cpu;
+        let set = set();
+        let varmap = VarMap::new();
+        let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
+        let loss = |foot: f64| {
+            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, LossTerms { geo: 1.0, vel: 0.0, foot, weighting: Weighting::V }, &dev)
+                .unwrap()
+                .to_scalar::<f32>()
+                .unwrap() as f64
+        };
+        let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
+        // The quadruped's crops have planted feet, and an untrained model moves them.
         assert!(one > off, "{one} vs {off}");
         assert!(((two - off) - 2.0 * (one - off)).abs() < 1e-4 * two.abs().max(1.0), "{off} {one} {two}");
     }
@@ -1252,7 +1399,7 @@ mod tests {
         let schedule = Schedule::cosine_shifted(100, 10.0);
         for seed in [3, 9, 21] {
             let loss = |weighting| {
-                let terms = LossTerms { geo: 1.0, vel: 0.5, weighting };
+                let terms = LossTerms { geo: 1.0, vel: 0.5, foot: 0.0, weighting };
                 training_loss(&model, &set, &schedule, &mut SplitMix64::new(seed), 1, 12, terms, &dev).unwrap().to_scalar::<f32>().unwrap() as f64
             };
             let step = draw_step(&set, &schedule, &mut SplitMix64::new(seed), 1, 12).unwrap().groups[0].steps[0] as usize;

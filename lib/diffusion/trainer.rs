@@ -256,6 +256,8 @@ pub struct AnyTopOptions {
     pub lambda_geo: f64,
     /// Weight of the velocity loss (frame-to-frame changes) next to the MSE.
     pub lambda_vel: f64,
+    /// Weight of the foot-slide loss (`train::foot_slide_error`) next to the MSE.
+    pub lambda_foot: f64,
     /// How diffusion steps weigh in the loss: none = `DEFAULT_WEIGHTING` for a new run, the
     /// checkpoint's for a resumed one or a fine-tune.
     pub weighting: Option<Weighting>,
@@ -442,6 +444,7 @@ pub struct AnyTopTrainer {
     crop: usize,
     lambda_geo: f64,
     lambda_vel: f64,
+    lambda_foot: f64,
     ema: Option<Ema>,
     device: Device,
 }
@@ -559,6 +562,7 @@ impl AnyTopTrainer {
             crop: opts.crop,
             lambda_geo: opts.lambda_geo,
             lambda_vel: opts.lambda_vel,
+            lambda_foot: opts.lambda_foot,
             ema,
             device: device.clone(),
         })
@@ -582,7 +586,7 @@ impl Trainer for AnyTopTrainer {
             &mut rng,
             self.batch,
             self.crop,
-            LossTerms { geo: self.lambda_geo, vel: self.lambda_vel, weighting: self.info.weighting },
+            LossTerms { geo: self.lambda_geo, vel: self.lambda_vel, foot: self.lambda_foot, weighting: self.info.weighting },
             &self.device,
         )?;
         if stats.loss.is_finite() {
