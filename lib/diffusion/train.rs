@@ -739,11 +739,7 @@ pub fn foot_slide_error(predicted: &Tensor, clean: &Tensor, velocity_std: &Tenso
     let turned_x = (c.broadcast_mul(&x0)? + s.broadcast_mul(&z0)?)?;
     let turned_z = (c.broadcast_mul(&z0)? - s.broadcast_mul(&x0)?)?;
     let moved = Tensor::cat(
-        &[
-            dims(&p1, 0, 1)?.sub(&turned_x)?.broadcast_add(&vx)?,
-            (dims(&p1, 1, 1)? - y0)?,
-            dims(&p1, 2, 1)?.sub(&turned_z)?.broadcast_add(&vz)?,
-        ],
+        &[dims(&p1, 0, 1)?.sub(&turned_x)?.broadcast_add(&vx)?, (dims(&p1, 1, 1)? - y0)?, dims(&p1, 2, 1)?.sub(&turned_z)?.broadcast_add(&vz)?],
         3,
     )?;
     let target = dims(&clean.narrow(1, 1, t - 2)?, DIMS_VELOCITY.start, 3)?;
@@ -1327,10 +1323,19 @@ mod tests {
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
         let loss = |vel: f64| {
-            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, LossTerms { geo: 1.0, vel, foot: 0.0, weighting: Weighting::X0 }, &dev)
-                .unwrap()
-                .to_scalar::<f32>()
-                .unwrap() as f64
+            training_loss(
+                &model,
+                &set,
+                &Schedule::cosine(100),
+                &mut SplitMix64::new(9),
+                3,
+                12,
+                LossTerms { geo: 1.0, vel, foot: 0.0, weighting: Weighting::X0 },
+                &dev,
+            )
+            .unwrap()
+            .to_scalar::<f32>()
+            .unwrap() as f64
         };
         let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
         // Same draws, so the term is linear in its weight; an untrained model's changes are off.
@@ -1345,10 +1350,19 @@ mod tests {
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
         let loss = |foot: f64| {
-            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, LossTerms { geo: 1.0, vel: 0.0, foot, weighting: Weighting::V }, &dev)
-                .unwrap()
-                .to_scalar::<f32>()
-                .unwrap() as f64
+            training_loss(
+                &model,
+                &set,
+                &Schedule::cosine(100),
+                &mut SplitMix64::new(9),
+                3,
+                12,
+                LossTerms { geo: 1.0, vel: 0.0, foot, weighting: Weighting::V },
+                &dev,
+            )
+            .unwrap()
+            .to_scalar::<f32>()
+            .unwrap() as f64
         };
         let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
         // The quadruped's crops have planted feet, and an untrained model moves them.
