@@ -80,7 +80,7 @@ fn main() {
     let samplers: &[(Sampler, usize)] = if quick { &[(Sampler::Ddim, 20)] } else { &[(Sampler::Ddim, 20), (Sampler::Ddpm, 100)] };
     let fps = if skeleton.frame_time > 0.0 { 1.0 / skeleton.frame_time } else { 30.0 };
     for &(sampler, steps) in samplers {
-        let opts = SampleOptions { samples: n, frames, steps, sampler, seed: 1 };
+        let opts = SampleOptions { samples: n, frames, steps, sampler, seed: 1, lock: None };
         let methods: &[&str] = if quick { &["imposed every step"] } else { &["imposed every step", "paste after sampling", "upstream (zeros), pasted"] };
         for &method in methods {
             let started = std::time::Instant::now();

@@ -23,7 +23,7 @@ _mo__sample() {
 
     case "${cmd}" in
         mo__sample)
-            opts="-n -o -q -v -h -V --skeleton --model --samples --frames --seconds --steps --sampler --bvh --reference --keep-frames --keep-joints --report --examples --smooth --blend --no-plant-feet --output --seed --quiet --verbose --threads --animation --fps --help --version"
+            opts="-n -o -q -v -h -V --skeleton --model --samples --frames --seconds --steps --sampler --bvh --reference --keep-frames --keep-joints --report --examples --smooth --blend --no-plant-feet --lock-feet --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0

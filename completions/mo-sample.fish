@@ -20,6 +20,7 @@ complete -c mo-sample -l animation -d 'glTF inputs: the animation that becomes t
 complete -c mo-sample -l fps -d 'glTF inputs: sample the animation at this frame rate (default: at its keyframe times)' -r
 complete -c mo-sample -l report -d 'Print seam continuity as one JSON line on stderr (with --reference), or with --examples the synthesis levels and match costs'
 complete -c mo-sample -l no-plant-feet -d 'Keep the model\'s root travel even where it makes planted feet slide (by default the root\'s horizontal motion follows the feet the model puts on the ground)'
+complete -c mo-sample -l lock-feet -d 'Hold planted feet in place: in the last sampling steps (the last three of DDIM\'s 10) each foot the model puts down near the ground is held where it landed, its leg bent to reach, and the remaining steps fit the body to it. Measured on the built-in model (models/zoo-compact/MODEL_CARD.md): the zoo quadruped\'s feet slide 0.39 -> 0.11 body sizes/s (its clips 0-0.12) with poses as near its clips, but it moves about a fifth less, and the spider, whose feet did not slide, a quarter less; so it is not the default'
 complete -c mo-sample -s q -l quiet -d 'Print nothing on stderr but errors'
 complete -c mo-sample -s v -l verbose -d 'Print more about what is happening on stderr'
 complete -c mo-sample -s h -l help -d 'Print help (see more with \'--help\')'

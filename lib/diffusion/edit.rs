@@ -448,7 +448,7 @@ mod tests {
         mask.keep_frames(&[0..2, 6..8]);
         mask.keep_joints(&[1, 2], 0..frames);
         for (steps, sampler) in [(4, Sampler::Ddpm), (3, Sampler::Ddim)] {
-            let opts = SampleOptions { samples: 2, frames, steps, sampler, seed: 5 };
+            let opts = SampleOptions { samples: 2, frames, steps, sampler, seed: 5, lock: None };
             let a = sample_edit(&fx.model, &schedule, &cond, &opts, &fx.reference, &mask, &Device::Cpu).unwrap();
             let b = sample_edit(&fx.model, &schedule, &cond, &opts, &fx.reference, &mask, &Device::Cpu).unwrap();
             assert_eq!(a, b, "same seed, same samples");
@@ -471,7 +471,7 @@ mod tests {
             }
         }
         // Nothing kept: exactly plain sampling (the known part's noise is a stream of its own).
-        let opts = SampleOptions { samples: 1, frames, steps: 3, sampler: Sampler::Ddpm, seed: 9 };
+        let opts = SampleOptions { samples: 1, frames, steps: 3, sampler: Sampler::Ddpm, seed: 9, lock: None };
         let plain = super::super::sample::sample(&fx.model, &schedule, &cond, &opts, &Device::Cpu).unwrap();
         let edit = sample_edit(&fx.model, &schedule, &cond, &opts, &fx.reference, &KeepMask::new(frames, j), &Device::Cpu).unwrap();
         assert_eq!(plain, edit);
@@ -492,7 +492,7 @@ mod tests {
         for v in &mut other.data[..4 * j * 13] {
             *v += 1.5;
         }
-        let opts = SampleOptions { samples: 1, frames, steps: 3, sampler: Sampler::Ddim, seed: 2 };
+        let opts = SampleOptions { samples: 1, frames, steps: 3, sampler: Sampler::Ddim, seed: 2, lock: None };
         let a = sample_edit(&fx.model, &schedule, &cond, &opts, &fx.reference, &mask, &Device::Cpu).unwrap();
         let b = sample_edit(&fx.model, &schedule, &cond, &opts, &other, &mask, &Device::Cpu).unwrap();
         assert_ne!(a[0].data[4 * j * 13..], b[0].data[4 * j * 13..]);

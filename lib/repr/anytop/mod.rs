@@ -115,6 +115,7 @@
 mod decode;
 mod encode;
 mod ik;
+mod lock;
 pub mod named;
 pub mod placements;
 mod plant;
@@ -122,6 +123,7 @@ mod rig;
 mod stats;
 
 pub use ik::IkOptions;
+pub use lock::lock_feet;
 pub use named::NamedOverrides;
 pub use plant::plant_feet;
 pub use rig::AnyTopRig;
