@@ -184,8 +184,8 @@ pub struct Args {
     /// each foot the model puts down near the ground is held where it landed, its leg bent to
     /// reach, and the remaining steps fit the body to it. Measured on the built-in model
     /// (models/zoo-compact/MODEL_CARD.md): the zoo quadruped's feet slide 0.39 -> 0.11 body
-    /// sizes/s (its clips 0-0.12) with poses as near its clips, but it moves about a fifth less,
-    /// and the spider, whose feet did not slide, a quarter less; so it is not the default.
+    /// sizes/s (its clips 0-0.12) with poses as near its clips, but it moves a fifth less and
+    /// the spider 28% less (much of it the sliding itself); so it is not the default.
     #[arg(long)]
     pub lock_feet: bool,
     #[command(flatten)]
