@@ -72,6 +72,17 @@ fn edits_keep_the_reference_and_generate_the_rest() {
         let generated = |x: &Features| x.data[5 * j * 13..15 * j * 13].to_vec();
         assert_ne!(generated(sample), generated(other), "another seed, another middle");
     }
+    // Held feet leave kept frames as they are too.
+    let mut held = base("3");
+    held.extend(["--keep-frames", "0-4,15-19", "--lock-feet"]);
+    let held = run("mo-sample", &held, None);
+    ok(&held, "in-betweening with held feet");
+    for (sample, plain) in samples(&held.stdout).iter().zip(&got) {
+        assert_eq!(sample.data[..5 * j * 13], plain.data[..5 * j * 13], "kept frames, held feet or not");
+        assert_eq!(sample.data[15 * j * 13..], plain.data[15 * j * 13..], "kept frames, held feet or not");
+        assert_ne!(sample.data[5 * j * 13..15 * j * 13], plain.data[5 * j * 13..15 * j * 13], "holding the feet changed the middle");
+    }
+
     // The report: one JSON line with the two seams of each sample and the reference's spread.
     let report: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&a.stderr).trim()).unwrap();
     let seams = report["samples"][0]["seams"].as_array().unwrap();
@@ -99,24 +110,28 @@ fn edits_keep_the_reference_and_generate_the_rest() {
         assert_ne!(sample.data[5 * j * 13..15 * j * 13], raw.data[5 * j * 13..15 * j * 13], "the middle is smoothed");
     }
 
-    // Body-part editing with DDIM: the legs (thighs and below) are the reference's in every frame.
-    let mut args = base("3");
-    args.extend(["--sampler", "ddim", "--keep-joints", "*Thigh/"]);
-    let b = run("mo-sample", &args, None);
-    ok(&b, "body part");
-    let legs: Vec<usize> = (0..j)
-        .filter(|&jj| {
-            let names = ["Bip01_L_Thigh", "Bip01_L_Calf", "Bip01_L_Foot", "Bip01_L_Toe0", "Bip01_R_Thigh", "Bip01_R_Calf", "Bip01_R_Foot", "Bip01_R_Toe0"];
-            let arg = menagerie::cli::load::read_skeleton(&quad).unwrap();
-            names.contains(&arg.skeleton.joints[jj].name.as_str())
-        })
-        .collect();
-    assert_eq!(legs.len(), 8);
-    for sample in samples(&b.stdout) {
-        for f in 0..20 {
-            for jj in 0..j {
-                let same = sample.at(f, jj).iter().zip(reference.at(f, jj)).all(|(x, y)| (x - y).abs() <= 1e-4);
-                assert_eq!(same, legs.contains(&jj), "frame {f} joint {jj}: kept exactly when a leg joint");
+    // Body-part editing with DDIM: the legs (thighs and below) are the reference's in every frame,
+    // also when the feet are held (--lock-feet moves legs, but never kept ones).
+    for extra in [&[][..], &["--lock-feet"][..]] {
+        let mut args = base("3");
+        args.extend(["--sampler", "ddim", "--keep-joints", "*Thigh/"]);
+        args.extend(extra);
+        let b = run("mo-sample", &args, None);
+        ok(&b, "body part");
+        let legs: Vec<usize> = (0..j)
+            .filter(|&jj| {
+                let names = ["Bip01_L_Thigh", "Bip01_L_Calf", "Bip01_L_Foot", "Bip01_L_Toe0", "Bip01_R_Thigh", "Bip01_R_Calf", "Bip01_R_Foot", "Bip01_R_Toe0"];
+                let arg = menagerie::cli::load::read_skeleton(&quad).unwrap();
+                names.contains(&arg.skeleton.joints[jj].name.as_str())
+            })
+            .collect();
+        assert_eq!(legs.len(), 8);
+        for sample in samples(&b.stdout) {
+            for f in 0..20 {
+                for jj in 0..j {
+                    let same = sample.at(f, jj).iter().zip(reference.at(f, jj)).all(|(x, y)| (x - y).abs() <= 1e-4);
+                    assert_eq!(same, legs.contains(&jj), "{extra:?} frame {f} joint {jj}: kept exactly when a leg joint");
+                }
             }
         }
     }
