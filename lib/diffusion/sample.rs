@@ -31,7 +31,7 @@ pub struct Condition<'a> {
 /// (issue 22: 91% of the built-in's near-ground foot steps had the contact channel on and slid
 /// at 0.32 sizes/s). Locking the finished sample holds them but bends the legs away from the
 /// model's poses (the running dog's nearest pose 0.0137 -> 0.0158); locking inside the last
-/// three DDIM steps gives the same skating with poses at or nearer than the model's own, at a
+/// three DDIM steps gives the same skating with poses within 0.0005 of the model's own, at a
 /// cost in motion (models/zoo-compact/MODEL_CARD.md, "Feet held inside the sampler"), so
 /// `mo-sample` does it only when asked (`--lock-feet`).
 #[derive(Clone, Debug)]
