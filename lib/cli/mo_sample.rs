@@ -185,7 +185,7 @@ pub struct Args {
     /// reach, and the remaining steps fit the body to it. Measured on the built-in model
     /// (models/zoo-compact/MODEL_CARD.md): the zoo quadruped's feet slide 0.39 -> 0.11 body
     /// sizes/s (its clips 0-0.12) with poses as near its clips, but it moves a fifth less and
-    /// the spider 28% less (much of it the sliding itself); so it is not the default.
+    /// the spider 28% less; so it is not the default.
     #[arg(long)]
     pub lock_feet: bool,
     #[command(flatten)]
