@@ -654,44 +654,37 @@ fn loss_sums(
     } else {
         None
     };
-    let foot = if terms.foot != 0.0 && t > 2 {
-        let (mean, std) = physical_stats(set, crops, j, d, device)?;
-        let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.broadcast_mul(&std)?.broadcast_add(&mean) };
-        let clean_physical = physical(&clean.x)?;
-        let velocity_std = std.narrow(3, DIMS_VELOCITY.start, 3)?;
-        let pair_mask = (mask.narrow(1, 2, t - 2)? * mask.narrow(1, 1, t - 2)?)?;
-        let error = foot_slide_error(&physical(&predicted)?, &clean_physical, &velocity_std)?;
-        // Only where the clip's own foot is planted (the contact channel, 0 or 1 in physical units).
-        let contact = clean_physical.narrow(1, 1, t - 2)?.narrow(3, DIM_CONTACT, 1)?.ge(0.5)?.to_dtype(DType::F32)?;
-        // Counted by the signal's share of the input (ᾱ): from a noisy input the model cannot
-        // know which frames are planted, and the term then only teaches it to hold every joint
-        // still (a 1-creature proxy: energy 0.78 -> 0.28 with the term at every step).
-        let signal = a.sqr()?;
-        Some(weighed(error.broadcast_mul(&contact)?.broadcast_mul(&pair_mask)?.broadcast_mul(&signal)?)?.sum_all()?)
-    } else {
-        None
-    };
-    if terms.geo == 0.0 {
-        return Ok(LossSums { squared, values, rotation: None, tokens, velocity, foot });
-    }
-    // The rotation term needs the 6D values in physical units: undo each skeleton's
-    // normalisation (padded joints get mean 0, std 1; they are masked anyway).
-    let (mut mean, mut std) = (vec![0f32; b * j * 6], vec![1f32; b * j * 6]);
-    for (i, c) in crops.iter().enumerate() {
-        let sk = set.data(c);
-        for jj in 0..sk.skeleton.len() {
-            for k in 0..6 {
-                mean[(i * j + jj) * 6 + k] = sk.stats.mean[jj * d + 3 + k];
-                std[(i * j + jj) * 6 + k] = sk.stats.std[jj * d + 3 + k] + crate::repr::anytop::STD_EPSILON;
-            }
+    // The rotation and foot terms work in physical units: undo each skeleton's normalisation
+    // (padded joints get mean 0, std 1; they are masked anyway). Built once for both.
+    let with_foot = terms.foot != 0.0 && t > 2;
+    let stats = if terms.geo != 0.0 || with_foot { Some(physical_stats(set, crops, j, d, device)?) } else { None };
+    let foot = match &stats {
+        Some((mean, std)) if with_foot => {
+            let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.broadcast_mul(std)?.broadcast_add(mean) };
+            let clean_physical = physical(&clean.x)?;
+            let velocity_std = std.narrow(3, DIMS_VELOCITY.start, 3)?;
+            let pair_mask = (mask.narrow(1, 2, t - 2)? * mask.narrow(1, 1, t - 2)?)?;
+            let error = foot_slide_error(&physical(&predicted)?, &clean_physical, &velocity_std)?;
+            // Only where the clip's own foot is planted (the contact channel, 0 or 1 in physical units).
+            let contact = clean_physical.narrow(1, 1, t - 2)?.narrow(3, DIM_CONTACT, 1)?.ge(0.5)?.to_dtype(DType::F32)?;
+            // Counted by the signal's share of the input (ᾱ): from a noisy input the model cannot
+            // know which frames are planted, and the term then only teaches it to hold every joint
+            // still (a 1-creature proxy: energy 0.78 -> 0.28 with the term at every step).
+            let signal = a.sqr()?;
+            Some(weighed(error.broadcast_mul(&contact)?.broadcast_mul(&pair_mask)?.broadcast_mul(&signal)?)?.sum_all()?)
         }
-    }
-    let mean = Tensor::from_vec(mean, (b, 1, j, 6), device)?;
-    let std = Tensor::from_vec(std, (b, 1, j, 6), device)?;
-    let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(3, 3, 6)?.broadcast_mul(&std)?.broadcast_add(&mean) };
-    let geo = rotation_distance(&physical(&predicted)?, &physical(&clean.x)?)?;
-    let rotation = weighed(geo.unsqueeze(3)?.broadcast_mul(&mask)?)?.sum_all()?;
-    Ok(LossSums { squared, values, rotation: Some(rotation), tokens, velocity, foot })
+        _ => None,
+    };
+    let rotation = match &stats {
+        Some((mean, std)) if terms.geo != 0.0 => {
+            let (mean, std) = (mean.narrow(3, DIMS_ROTATION.start, 6)?, std.narrow(3, DIMS_ROTATION.start, 6)?);
+            let physical = |x: &Tensor| -> candle_core::Result<Tensor> { x.narrow(3, DIMS_ROTATION.start, 6)?.broadcast_mul(&std)?.broadcast_add(&mean) };
+            let geo = rotation_distance(&physical(&predicted)?, &physical(&clean.x)?)?;
+            Some(weighed(geo.unsqueeze(3)?.broadcast_mul(&mask)?)?.sum_all()?)
+        }
+        _ => None,
+    };
+    Ok(LossSums { squared, values, rotation, tokens, velocity, foot })
 }
 
 /// Each crop's per-joint means and spreads (`STD_EPSILON` added), `(b, 1, j, d)`; padded
@@ -1320,28 +1313,22 @@ mod tests {
         assert!(single > plain && single < tripled, "{single}: plain {plain}, all tripled {tripled}");
     }
 
-    #[test]
-    fn the_velocity_loss_adds_the_error_of_frame_to_frame_changes() {
+    /// The loss of one fixed draw from an untrained model with the terms `terms(w)` makes, at
+    /// weights 0, 1 and 2 of the term under test.
+    fn losses_at_weights(terms: impl Fn(f64) -> LossTerms) -> (f64, f64, f64) {
         let dev = Device::Cpu;
         let set = set();
         let varmap = VarMap::new();
         let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
-        let loss = |vel: f64| {
-            training_loss(
-                &model,
-                &set,
-                &Schedule::cosine(100),
-                &mut SplitMix64::new(9),
-                3,
-                12,
-                LossTerms { geo: 1.0, vel, foot: 0.0, weighting: Weighting::X0 },
-                &dev,
-            )
-            .unwrap()
-            .to_scalar::<f32>()
-            .unwrap() as f64
+        let loss = |w: f64| {
+            training_loss(&model, &set, &Schedule::cosine(100), &mut SplitMix64::new(9), 3, 12, terms(w), &dev).unwrap().to_scalar::<f32>().unwrap() as f64
         };
-        let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
+        (loss(0.0), loss(1.0), loss(2.0))
+    }
+
+    #[test]
+    fn the_velocity_loss_adds_the_error_of_frame_to_frame_changes() {
+        let (off, one, two) = losses_at_weights(|vel| LossTerms { geo: 1.0, vel, foot: 0.0, weighting: Weighting::X0 });
         // Same draws, so the term is linear in its weight; an untrained model's changes are off.
         assert!(one > off, "{one} vs {off}");
         assert!(((two - off) - 2.0 * (one - off)).abs() < 1e-4 * two.abs().max(1.0), "{off} {one} {two}");
@@ -1349,26 +1336,7 @@ mod tests {
 
     #[test]
     fn the_foot_loss_adds_the_slide_of_planted_joints() {
-        let dev = Device::Cpu;
-        let set = set();
-        let varmap = VarMap::new();
-        let model = Denoiser::new(seeded_var_builder(&varmap, 4, &dev), &DenoiserConfig::tiny()).unwrap();
-        let loss = |foot: f64| {
-            training_loss(
-                &model,
-                &set,
-                &Schedule::cosine(100),
-                &mut SplitMix64::new(9),
-                3,
-                12,
-                LossTerms { geo: 1.0, vel: 0.0, foot, weighting: Weighting::V },
-                &dev,
-            )
-            .unwrap()
-            .to_scalar::<f32>()
-            .unwrap() as f64
-        };
-        let (off, one, two) = (loss(0.0), loss(1.0), loss(2.0));
+        let (off, one, two) = losses_at_weights(|foot| LossTerms { geo: 1.0, vel: 0.0, foot, weighting: Weighting::V });
         // The quadruped's crops have planted feet, and an untrained model moves them.
         assert!(one > off, "{one} vs {off}");
         assert!(((two - off) - 2.0 * (one - off)).abs() < 1e-4 * two.abs().max(1.0), "{off} {one} {two}");
