@@ -15,6 +15,7 @@
 use super::{check, EditError};
 use crate::metrics::physics::{self, PhysicsOptions};
 use crate::metrics::WorldClip;
+use crate::motion::contact::{self, Contact};
 use crate::motion::{ik, Motion};
 use crate::skeleton::Skeleton;
 use glam::{DQuat, DVec3};
@@ -184,30 +185,16 @@ fn arc(from: DVec3, to: DVec3) -> DQuat {
 /// first and after the last contact ease the offset from and to nothing.
 fn targets(row: &[bool], track: &[DVec3], blend: usize) -> Vec<Option<DVec3>> {
     let n = row.len().min(track.len());
-    // Contacts as (first, last, pin).
-    let mut contacts = Vec::new();
-    let mut f = 0;
-    while f < n {
-        if !row[f] {
-            f += 1;
-            continue;
-        }
-        let start = f;
-        while f < n && row[f] {
-            f += 1;
-        }
-        let pin = track[start..f].iter().copied().sum::<DVec3>() / (f - start) as f64;
-        contacts.push((start, f - 1, pin));
-    }
+    let contacts = contact::contacts(n, |t| row[t], |t| track[t]);
     let mut out = vec![None; n];
     let ease = |t: f64| 0.5 - 0.5 * (std::f64::consts::PI * t.clamp(0.0, 1.0)).cos();
-    for (i, &(start, end, pin)) in contacts.iter().enumerate() {
+    for (i, &Contact { first: start, last: end, pin }) in contacts.iter().enumerate() {
         for slot in out.iter_mut().take(end + 1).skip(start) {
             *slot = Some(pin);
         }
         let offset_out = pin - track[end];
         match contacts.get(i + 1) {
-            Some(&(next, _, next_pin)) => {
+            Some(&Contact { first: next, pin: next_pin, .. }) => {
                 let offset_in = next_pin - track[next];
                 for g in end + 1..next {
                     let t = (g - end) as f64 / (next - end) as f64;

@@ -6,6 +6,7 @@
 //! components are zero). Joints without position channels translate by their OFFSET.
 
 pub mod clip;
+pub mod contact;
 pub mod ik;
 pub mod rotation;
 pub mod write;

@@ -19,6 +19,7 @@
 
 use super::decode::root_yaw;
 use super::{get3, get_6d, put3, DIMS_POSITION, DIMS_ROTATION, DIMS_VELOCITY, DIM_CONTACT, FEATURE_DIMS};
+use crate::motion::contact::contacts;
 use crate::repr::Features;
 use glam::{DQuat, DVec3};
 
@@ -91,23 +92,6 @@ fn fabrik(points: &mut [DVec3], target: DVec3) {
     }
 }
 
-/// Stretches of frames (start, end inclusive) where `down(t)`.
-fn stretches(frames: usize, down: impl Fn(usize) -> bool) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for t in 0..=frames {
-        match (t < frames && down(t), start) {
-            (true, None) => start = Some(t),
-            (false, Some(s)) => {
-                out.push((s, t - 1));
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    out
-}
-
 /// How much of a stretch's target frame `t` takes: 1 inside, easing to 0 over `ease` frames
 /// outside (smoothstep, so the leg starts and stops moving gently).
 fn weight(t: usize, (s, e): (usize, usize), ease: usize) -> f64 {
@@ -172,12 +156,15 @@ pub fn lock_feet(features: &mut Features, parents: &[Option<usize>], feet: &[usi
     for &foot in &order {
         let Some(chain) = limb(parents, &children, &is_foot, foot) else { continue };
         let hanging = below(&children, foot);
-        let down = stretches(frames, |t| features.at(t, foot)[DIM_CONTACT] > IN_CONTACT && world[t * joints + foot].y <= ground + near_ground);
-        // Each stretch's target: the foot's mean horizontal position over it, taken after the
-        // feet above it were locked.
-        let targets: Vec<DVec3> = down.iter().map(|&(s, e)| (s..=e).map(|t| world[t * joints + foot]).sum::<DVec3>() / (e - s + 1) as f64).collect();
+        // Each stretch's target: the foot's mean position over it (its height is not pulled),
+        // taken after the feet above it were locked.
+        let down = contacts(
+            frames,
+            |t| features.at(t, foot)[DIM_CONTACT] > IN_CONTACT && world[t * joints + foot].y <= ground + near_ground,
+            |t| world[t * joints + foot],
+        );
         for t in 0..frames {
-            let pulls: Vec<(f64, DVec3)> = down.iter().zip(&targets).map(|(&st, &g)| (weight(t, st, ease), g)).filter(|(w, _)| *w > 0.0).collect();
+            let pulls: Vec<(f64, DVec3)> = down.iter().map(|c| (weight(t, (c.first, c.last), ease), c.pin)).filter(|(w, _)| *w > 0.0).collect();
             if pulls.is_empty() || fixed.is_some_and(|m| chain[1..].iter().chain(&hanging).any(|&j| m.get(t * joints + j).copied().unwrap_or(true))) {
                 continue;
             }
