@@ -119,7 +119,10 @@ fn a_fine_tune_carries_its_models_unseen_denoiser() {
     }
     assert!(!from_builtin.join(".unseen.partial").exists(), "the temporary folder is left behind");
     // Resuming the fine-tune (--init kept on the command line) is a resume: nothing is carried
-    // again, and the carried folder stays as it was.
+    // again, and the carried folder stays as it was. Equal bytes alone would also pass a fresh
+    // copy, so a file only this test puts there must survive the resume.
+    let marker = from_builtin.join("unseen/left-by-the-test");
+    std::fs::write(&marker, b"x").unwrap();
     let resumed = run("mo-train", &[s(&example("quadruped.bvh")), "--init", "builtin", "--out", s(&from_builtin), "--steps", "2", "--resume"], None);
     ok(&resumed, "resumed fine-tune");
     assert!(!String::from_utf8_lossy(&resumed.stderr).contains("carried"), "{}", String::from_utf8_lossy(&resumed.stderr));
@@ -127,6 +130,8 @@ fn a_fine_tune_carries_its_models_unseen_denoiser() {
         std::fs::read(from_builtin.join("unseen/model.safetensors")).unwrap()
             == std::fs::read(root.join("models/zoo-compact/unseen/model.safetensors")).unwrap()
     );
+    assert!(marker.exists(), "the resume replaced the carried unseen/ folder");
+    std::fs::remove_file(&marker).unwrap();
     // A skeleton neither the built-in nor the tuned model trained on (an augmented crab) samples
     // from the tuned model as from the built-in: both through the built-in's unseen denoiser.
     let crab = dir.join("crab_aug.bvh");
