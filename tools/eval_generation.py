@@ -30,6 +30,7 @@ METRICS = [
     ("duty_factor", "duty"),
     ("mixed_contact", "mixed contact"),
     ("alternation", "alternation"),
+    ("footfall_error", "footfall"),
     ("coverage", "coverage %"),
     ("local_diversity", "local div"),
     ("inter_diversity", "inter div"),
@@ -63,7 +64,9 @@ def metrics(bindir, folder, generated, skeleton):
     report = full["report"]
     movement = full["movement"]
     out = {k: movement["samples"][k] if k in movement["samples"] else report[k]["mean"] for k, _ in METRICS}
-    out["baselines"] = movement["baselines"]
+    out["baselines"] = dict(movement["baselines"])
+    # The footfall error of feet phased at random: a baseline row of its own.
+    out["baselines"]["random_phases"] = {"footfall_error": movement.get("footfall_chance")}
     files = clips(generated) if os.path.isdir(generated) else []
     if files:
         phys = json.loads(run([f"{bindir}/mo-metrics", "physics"] + files))["files"]
@@ -156,7 +159,7 @@ def main():
             m = metrics(args.bin, folder, out, skeleton)
             if base is None:
                 base = m["baselines"]
-                for key, text in [("clips", "clips, leave-one-out"), ("mean_pose", "static mean pose"), ("random_crops", "random crops")]:
+                for key, text in [("clips", "clips, leave-one-out"), ("mean_pose", "static mean pose"), ("random_crops", "random crops"), ("random_phases", "feet phased at random")]:
                     b = dict(base[key])
                     print(row([name, text] + [num(b.get(k), k) if k in b else "" for k, _ in METRICS] + [""] * len(PHYSICS)), flush=True)
             print(row([name, label] + cells(m)), flush=True)

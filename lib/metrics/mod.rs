@@ -8,6 +8,7 @@
 
 pub mod checks;
 pub mod fid;
+pub mod footfall;
 pub mod generation;
 pub mod geometric;
 pub mod kinetic;

@@ -25,10 +25,14 @@
 //!   Mixed contact cannot see this: feet lifted together at odd times still give some up and
 //!   some down.
 //!
+//! * footfall error: how far the feet's phases against each other lie from the nearest
+//!   stretch of the clips (`footfall`), next to the level of feet phased at random.
+//!
 //! Every loop over frames or windows is bounded by caps on the reference frames and windows
 //! (strided evenly), so a 15,000-frame capture scores in seconds; every result is the same at
 //! any thread count (parallel loops fill per-item slots, reductions run in order).
 
+use super::footfall::Footfalls;
 use super::generation::PointClip;
 use super::physics::{contacts, Ground, PhysicsOptions};
 use super::{MetricError, WorldClip};
@@ -89,6 +93,10 @@ pub struct Movement {
     /// pooled over the motions by how long and how much their feet move (`None`: fewer than
     /// two feet, or no motion moves them).
     pub alternation: Option<f64>,
+    /// Mean circular distance (cycles, 0-0.5) of the feet's relative phases to the nearest
+    /// clip stretch's (`footfall`; `None`: no stretch of these motions or of the clips has two
+    /// feet swinging).
+    pub footfall_error: Option<f64>,
 }
 
 /// A skeleton's clips, prepared once: world clips for energy, contact and poses, AnyTop point
@@ -106,6 +114,7 @@ pub struct Reference<'a> {
     /// Windows with a window of another clip at a finite distance: those the other clips
     /// cover, since each threshold is at least that distance.
     covered_by_others: usize,
+    footfalls: Footfalls,
     /// The median of the clip windows' nearest-window distances, in the point clips' units:
     /// the smallest threshold asked for (zoo clips repeat one another exactly, and a sample
     /// need not be closer to them than the clips typically are to each other).
@@ -323,7 +332,15 @@ impl<'a> Reference<'a> {
         // with no other far enough away) is judged at the floor.
         let thresholds = nearest.iter().map(|&d| if d.is_finite() { d.max(floor) } else { floor }).collect();
         let covered_by_others = nearest.iter().filter(|d| d.is_finite()).count();
-        Ok(Reference { clips, points, energy, poses, targets, thresholds, covered_by_others, threshold: floor, opts: opts.clone() })
+        let footfalls = Footfalls::new(points, &clips[0].feet);
+        Ok(Reference { clips, points, energy, poses, targets, thresholds, covered_by_others, footfalls, threshold: floor, opts: opts.clone() })
+    }
+
+    /// The footfall error of feet phased at random against these clips (seeded), the level
+    /// of a model that learned each leg's stride but not how the legs go together; `None`
+    /// when the clips have no stretch with two feet swinging.
+    pub fn footfall_chance(&self, seed: u64) -> Option<f64> {
+        self.footfalls.chance(self.clips[0].feet.iter().filter(|&&j| j >= 1 && j <= self.points[0].points()).count(), seed)
     }
 
     /// The clips' mean energy, sizes per second.
@@ -404,6 +421,7 @@ impl<'a> Reference<'a> {
             duty_factor: mean_of(stats.iter().filter_map(|s| s.0).collect()),
             mixed_contact: mean_of(stats.iter().filter_map(|s| s.1).collect()),
             alternation: pooled(&alternations),
+            footfall_error: self.footfalls.error(points, &motions[0].feet, skip),
         })
     }
 
@@ -450,6 +468,7 @@ impl<'a> Reference<'a> {
             duty_factor: avg_opt(&|p| p.1),
             mixed_contact: avg_opt(&|p| p.2),
             alternation: pooled(&parts.iter().filter_map(|p| p.3).collect::<Vec<_>>()),
+            footfall_error: self.footfalls.leave_one_out(),
         })
     }
 

@@ -271,6 +271,8 @@ pub fn generation_report(gt: &[Clip], gen: &[Clip], section: &AnyTopSection, opt
             ("duty_factor", "share of frames a foot is in contact"),
             ("mixed_contact", "share of frames with some feet down and some up"),
             ("alternation", "share of the feet's horizontal swing that is against a partner foot, not with it (1: a walk's left against right, 0: all together)"),
+            ("footfall_error", "cycles, 0-0.5: the feet's phases against each other, from the nearest clip stretch's (0: the clips' footfall order)"),
+            ("footfall_chance", "cycles: footfall_error of feet phased at random"),
             ("local_diversity", "mean joint distance, AnyTop units (mean SMPL bone = 0.209)"),
             ("global_diversity", "mean joint distance per frame, AnyTop units"),
             ("inter_diversity", "mean joint distance, AnyTop units"),
@@ -298,6 +300,7 @@ fn movement_report(gt: &[Clip], gen: &[Clip], gt_points: &[PointClip], gen_point
     let crops = reference.score(&crop_world, &crop_points, None)?;
     Ok(json!({
         "threshold": reference.threshold,
+        "footfall_chance": reference.footfall_chance(seed),
         "samples": samples,
         "baselines": { "clips": clips, "mean_pose": mean_pose, "random_crops": crops },
     }))

@@ -147,9 +147,9 @@ fn kept_frames_and_joints_are_the_references() {
 
 /// Known answer: samples from one synthetic zoo clip (the bundled dragon: 88 frames of a walk in
 /// place with flapping wings) move like it (energy), hold poses of it (nearest pose), cover its
-/// windows and differ from each other. (A clip that repeats itself exactly, like a fresh
-/// `synth::creature_bvh`, gives calibrated coverage a threshold of 0, which nothing but a copy
-/// meets.)
+/// windows, keep its footfall order and differ from each other. (A clip that repeats itself
+/// exactly, like a fresh `synth::creature_bvh`, gives calibrated coverage a threshold of 0,
+/// which nothing but a copy meets.)
 #[test]
 fn samples_of_a_zoo_walk_move_like_it() {
     let dir = tempdir("quality");
@@ -171,4 +171,8 @@ fn samples_of_a_zoo_walk_move_like_it() {
     assert!(nearest <= 0.01, "nearest pose {nearest}");
     assert!(coverage >= 90.0, "calibrated coverage {coverage}: {}", report["movement"]);
     assert!(inter > 0.0, "inter diversity {inter}");
+    // Patches of the clip keep its footfall order: far nearer it than feet phased at random.
+    let footfall = movement["footfall_error"].as_f64().unwrap();
+    let chance = report["movement"]["footfall_chance"].as_f64().unwrap();
+    assert!(footfall < chance / 4.0, "footfall error {footfall} against chance {chance}");
 }
