@@ -33,8 +33,9 @@ pub const SEGMENT: usize = 60;
 pub const MIN_SWING: f64 = 0.02;
 /// Random patterns drawn for the chance level.
 const CHANCE_DRAWS: usize = 512;
-/// At most this many segments per set of motions (evenly strided), as the window caps.
-const MAX_SEGMENTS: usize = 2000;
+/// At most this many segments per set of motions (evenly strided), which bounds the
+/// comparisons as the window caps do; a 15,000-frame capture still gives one every 30 frames.
+const MAX_SEGMENTS: usize = 500;
 
 /// Relative phases (cycles, in [0, 1)) of every pair (i < k) of feet in one segment, in pair
 /// order; `None` where either foot barely swings.
