@@ -16,10 +16,10 @@
 use candle_core::Device;
 use menagerie::cli::load::{expand_inputs, load_motions, LoadOptions};
 use menagerie::diffusion::checkpoint;
-use menagerie::diffusion::data::{Augmentation, TrainSet};
+use menagerie::diffusion::data::{Augmentation, SkeletonData, TrainSet};
 use menagerie::diffusion::Schedule;
 use menagerie::embed::NameTable;
-use menagerie::nn::{batch_from, BatchItem};
+use menagerie::nn::{batch_from, BatchItem, Denoiser};
 use menagerie::repr::Features;
 use menagerie::rng::SplitMix64;
 
@@ -38,6 +38,18 @@ fn motion_of(f: &[f32], frames: usize, joints: usize, dims: usize, mean: &[f32],
         }
     }
     total
+}
+
+/// A clean crop noised as training noises it: `a·x + b·ε`.
+fn noised(clean: &Features, noise: &[f32], (a, b): (f64, f64)) -> Features {
+    Features { data: clean.data.iter().zip(noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() }
+}
+
+/// The model's x0 prediction for `f` (one item of skeleton `s`) at step `t`, the rest token
+/// dropped: `f.frames × joints × dims` values.
+fn predict(model: &Denoiser, s: &SkeletonData, f: &Features, t: usize, device: &Device) -> anyhow::Result<Vec<f32>> {
+    let item = BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 };
+    Ok(model.forward(&batch_from(&[item], &[t as u32], device)?)?.narrow(1, 1, f.frames)?.contiguous()?.flatten_all()?.to_vec1()?)
 }
 
 fn main() -> anyhow::Result<()> {
@@ -61,14 +73,9 @@ fn main() -> anyhow::Result<()> {
         for c in &crops {
             let s = set.data(c);
             let clean: Features = set.crop(c);
-            let (a, b) = schedule.noise_coefficients(t);
             let noise = menagerie::rng::gaussian(&mut rng, clean.data.len());
-            let noisy = Features { data: clean.data.iter().zip(&noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() };
-            let item = BatchItem { features: &noisy, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 };
-            let batch = batch_from(&[item], &[t as u32], &device)?;
-            let pred = loaded.model.forward(&batch)?;
+            let x0 = predict(&loaded.model, s, &noised(&clean, &noise, schedule.noise_coefficients(t)), t, &device)?;
             let frames = clean.frames;
-            let x0: Vec<f32> = pred.narrow(1, 1, frames)?.contiguous()?.flatten_all()?.to_vec1()?;
             let (j, d) = (clean.joints, clean.dims);
             ratio_num += motion_of(&x0, frames, j, d, &s.stats.mean, &s.stats.std, 1);
             ratio_den += motion_of(&clean.data, frames, j, d, &s.stats.mean, &s.stats.std, 1);
@@ -99,13 +106,7 @@ fn main() -> anyhow::Result<()> {
 /// predicted x0 at frame offsets 0, 1, 3, 8 and 15 from the nudged frame, next to how much two
 /// different noise draws change the prediction (0 = the prediction ignores the noise, so every
 /// sample from pure noise would be the same).
-fn sensitivity(
-    model: &menagerie::nn::Denoiser,
-    set: &TrainSet,
-    schedule: &Schedule,
-    crops: &[menagerie::diffusion::data::Crop],
-    device: &Device,
-) -> anyhow::Result<()> {
+fn sensitivity(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[menagerie::diffusion::data::Crop], device: &Device) -> anyhow::Result<()> {
     let offsets = [0usize, 1, 3, 8, 15];
     println!();
     println!("| t | change of x0 at offset 0 / 1 / 3 / 8 / 15 after a nudge at one frame | change between two noise draws |");
@@ -120,28 +121,21 @@ fn sensitivity(
             if clean.frames < 40 {
                 continue;
             }
-            let (a, b) = schedule.noise_coefficients(t);
+            let ab = schedule.noise_coefficients(t);
             let width = clean.joints * clean.dims;
-            let noisy_with =
-                |noise: &[f32]| Features { data: clean.data.iter().zip(noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() };
-            let predict = |f: &Features| -> anyhow::Result<Vec<f32>> {
-                let item = BatchItem { features: f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 };
-                let batch = batch_from(&[item], &[t as u32], device)?;
-                Ok(model.forward(&batch)?.narrow(1, 1, f.frames)?.contiguous()?.flatten_all()?.to_vec1()?)
-            };
             let noise = menagerie::rng::gaussian(&mut rng, clean.data.len());
-            let base = noisy_with(&noise);
-            let p0 = predict(&base)?;
+            let base = noised(&clean, &noise, ab);
+            let p0 = predict(model, s, &base, t, device)?;
             let at = 10;
             let mut nudged = base.clone();
             nudged.data[at * width..(at + 1) * width].iter_mut().for_each(|v| *v += 0.5);
-            let p1 = predict(&nudged)?;
+            let p1 = predict(model, s, &nudged, t, device)?;
             for (k, &o) in offsets.iter().enumerate() {
                 let f = at + o;
                 change[k] += (f * width..(f + 1) * width).map(|i| (p1[i] - p0[i]).abs() as f64).sum::<f64>() / width as f64;
             }
-            let other = noisy_with(&menagerie::rng::gaussian(&mut rng, clean.data.len()));
-            let p2 = predict(&other)?;
+            let other = noised(&clean, &menagerie::rng::gaussian(&mut rng, clean.data.len()), ab);
+            let p2 = predict(model, s, &other, t, device)?;
             draws += p0.iter().zip(&p2).map(|(x, y)| (x - y).abs() as f64).sum::<f64>() / p0.len() as f64;
             n += 1.0;
         }
@@ -168,13 +162,7 @@ fn group_of(joint: usize, dim: usize) -> usize {
 /// At the cleanest steps, the model's normalised MSE per feature group next to the noisy
 /// input's own (x_t / a, whose MSE is (b / a)²): a model that has learnt to denoise finely
 /// beats its input there.
-fn by_group(
-    model: &menagerie::nn::Denoiser,
-    set: &TrainSet,
-    schedule: &Schedule,
-    crops: &[menagerie::diffusion::data::Crop],
-    device: &Device,
-) -> anyhow::Result<()> {
+fn by_group(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crops: &[menagerie::diffusion::data::Crop], device: &Device) -> anyhow::Result<()> {
     println!();
     println!("| t | the input x_t / a | {} |", GROUPS.join(" | "));
     println!("|---|---|{}", "---|".repeat(GROUPS.len()));
@@ -186,9 +174,7 @@ fn by_group(
             let s = set.data(c);
             let clean: Features = set.crop(c);
             let noise = menagerie::rng::gaussian(&mut rng, clean.data.len());
-            let noisy = Features { data: clean.data.iter().zip(&noise).map(|(x, e)| (a * *x as f64 + b * *e as f64) as f32).collect(), ..clean.clone() };
-            let item = BatchItem { features: &noisy, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 };
-            let x0: Vec<f32> = model.forward(&batch_from(&[item], &[t as u32], device)?)?.narrow(1, 1, clean.frames)?.contiguous()?.flatten_all()?.to_vec1()?;
+            let x0 = predict(model, s, &noised(&clean, &noise, (a, b)), t, device)?;
             for (i, (p, q)) in x0.iter().zip(&clean.data).enumerate() {
                 let g = group_of((i / clean.dims) % clean.joints, i % clean.dims);
                 sum[g] += ((p - q) * (p - q)) as f64;
@@ -207,13 +193,7 @@ fn by_group(
 /// 15-frame windows, stride 5, of the mean squared normalised joint position difference to the
 /// nearest clip window) and its frame-to-frame motion over the clip's; for SDEdit the final
 /// distance. A static mean pose (all zeros) and the crop itself are given for scale.
-fn trajectory(
-    model: &menagerie::nn::Denoiser,
-    set: &TrainSet,
-    schedule: &Schedule,
-    crop: &menagerie::diffusion::data::Crop,
-    device: &Device,
-) -> anyhow::Result<()> {
+fn trajectory(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crop: &menagerie::diffusion::data::Crop, device: &Device) -> anyhow::Result<()> {
     const FRAMES: usize = 120;
     const WINDOW: usize = 15;
     const SEEDS: u64 = 4;
@@ -266,9 +246,7 @@ fn trajectory(
     let run = |mut x: Vec<f32>, from: usize| -> anyhow::Result<Vec<Vec<f32>>> {
         let mut out = Vec::new();
         for st in &steps[from..] {
-            let f = Features { frames: FRAMES, joints: j, dims: d, data: x.clone() };
-            let item = BatchItem { features: &f, rest_row: &s.rest_row, relations: &s.relations, distances: &s.distances, names: &s.names, start: 0 };
-            let x0: Vec<f32> = model.forward(&batch_from(&[item], &[st.t as u32], device)?)?.narrow(1, 1, FRAMES)?.contiguous()?.flatten_all()?.to_vec1()?;
+            let x0 = predict(model, s, &Features { frames: FRAMES, joints: j, dims: d, data: x.clone() }, st.t, device)?;
             x = x0.iter().zip(&x).map(|(p, q)| (st.x0 * *p as f64 + st.xt * *q as f64) as f32).collect();
             out.push(x0);
         }
@@ -292,9 +270,8 @@ fn trajectory(
             moving[i] += motion(x0, FRAMES) / clip_motion.max(1e-12) / SEEDS as f64;
         }
         for (from, st) in steps.iter().enumerate() {
-            let (a, b) = schedule.noise_coefficients(st.t);
-            let start = reference.iter().zip(&noise).map(|(c, e)| (a * *c as f64 + b * *e as f64) as f32).collect();
-            let last = run(start, from)?.pop().unwrap_or_default();
+            let clip = Features { frames: FRAMES, joints: j, dims: d, data: reference.clone() };
+            let last = run(noised(&clip, &noise, schedule.noise_coefficients(st.t)).data, from)?.pop().unwrap_or_default();
             kept[from] += distance(&last) / SEEDS as f64;
         }
     }
