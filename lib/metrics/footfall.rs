@@ -85,8 +85,7 @@ fn segment_pattern(points: &PointClip, feet: &[usize], start: usize, len: usize)
         let w = std::f64::consts::TAU * k as f64 / n;
         x.iter().enumerate().fold((0.0, 0.0), |(re, im), (t, v)| (re + v * (w * t as f64).cos(), im - v * (w * t as f64).sin()))
     };
-    // Bins from one cycle per segment up to Nyquist; the window smears bin 1 into the mean, so
-    // it competes fairly only from bin 2 on when the segment is short, but a slow gait needs it.
+    // Bins from one cycle per segment (a slow gait's stride) up to Nyquist.
     let bins: Vec<Vec<[(f64, f64); 2]>> = (1..=len / 2).map(|k| paths.iter().map(|[x, z]| [spectrum(x, k), spectrum(z, k)]).collect()).collect();
     let power = |b: &Vec<[(f64, f64); 2]>| b.iter().map(|ax| ax.iter().map(|(r, i)| r * r + i * i).sum::<f64>()).sum::<f64>();
     let best = bins.iter().max_by(|a, b| power(a).total_cmp(&power(b)))?;
