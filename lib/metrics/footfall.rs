@@ -44,6 +44,11 @@ pub struct Pattern {
     pairs: Vec<Option<f64>>,
 }
 
+/// Mean of `d`; `None` when it is empty.
+fn mean(d: &[f64]) -> Option<f64> {
+    (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64)
+}
+
 /// Circular distance between two phases in cycles: 0 to 0.5.
 fn circular(a: f64, b: f64) -> f64 {
     let d = (a - b).rem_euclid(1.0);
@@ -53,13 +58,7 @@ fn circular(a: f64, b: f64) -> f64 {
 impl Pattern {
     /// Mean circular distance over the pairs phased in both; `None` when there are none.
     pub fn distance(&self, other: &Pattern) -> Option<f64> {
-        let d: Vec<f64> = self.pairs.iter().zip(&other.pairs).filter_map(|(a, b)| Some(circular((*a)?, (*b)?))).collect();
-        (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64)
-    }
-
-    /// Pairs with a phase.
-    pub fn phased(&self) -> usize {
-        self.pairs.iter().filter(|p| p.is_some()).count()
+        mean(&self.pairs.iter().zip(&other.pairs).filter_map(|(a, b)| Some(circular((*a)?, (*b)?))).collect::<Vec<f64>>())
     }
 }
 
@@ -120,25 +119,33 @@ fn segments(frames: usize) -> Vec<(usize, usize)> {
 }
 
 /// The patterns of every segment of `motions` (at most `MAX_SEGMENTS`, evenly strided), each
-/// with the motion it came from; `feet` are joint indices (the point clips hold joints 1..).
-pub fn patterns(motions: &[PointClip], feet: &[usize]) -> Vec<(usize, Pattern)> {
-    let idx: Vec<usize> = feet.iter().filter(|&&j| j >= 1 && motions.iter().all(|m| j <= m.points())).map(|&j| j - 1).collect();
-    if idx.len() < 2 {
+/// with the motion it came from; `points` are the feet's point indices (motions without all
+/// of them are left out).
+fn patterns(motions: &[PointClip], points: &[usize]) -> Vec<(usize, Pattern)> {
+    if points.len() < 2 {
         return Vec::new();
     }
-    let all: Vec<(usize, usize, usize)> = motions.iter().enumerate().flat_map(|(m, p)| segments(p.frames()).into_iter().map(move |(s, l)| (m, s, l))).collect();
+    let holds = |m: &PointClip| points.iter().all(|&p| p < m.points());
+    let all: Vec<(usize, usize, usize)> =
+        motions.iter().enumerate().filter(|(_, m)| holds(m)).flat_map(|(m, p)| segments(p.frames()).into_iter().map(move |(s, l)| (m, s, l))).collect();
     let stride = all.len().div_ceil(MAX_SEGMENTS).max(1);
-    all.into_iter().step_by(stride).filter_map(|(m, s, l)| segment_pattern(&motions[m], &idx, s, l).map(|p| (m, p))).collect()
+    all.into_iter().step_by(stride).filter_map(|(m, s, l)| segment_pattern(&motions[m], points, s, l).map(|p| (m, p))).collect()
 }
 
-/// The clips' footfall patterns, to score motions against.
+/// The clips' footfall patterns, to score motions of the same skeleton against.
 pub struct Footfalls {
+    /// The feet's point indices (joint − 1: the point clips hold joints 1..), those inside
+    /// every clip.
+    points: Vec<usize>,
     clips: Vec<(usize, Pattern)>,
 }
 
 impl Footfalls {
+    /// `feet` are joint indices.
     pub fn new(clips: &[PointClip], feet: &[usize]) -> Footfalls {
-        Footfalls { clips: patterns(clips, feet) }
+        let points: Vec<usize> = feet.iter().filter(|&&j| j >= 1 && clips.iter().all(|m| j <= m.points())).map(|&j| j - 1).collect();
+        let clips = patterns(clips, &points);
+        Footfalls { points, clips }
     }
 
     /// Whether any clip segment has a footfall pattern (else every error is `None`).
@@ -153,20 +160,19 @@ impl Footfalls {
 
     /// Mean over the phased segments of `motions` of the distance to the nearest clip
     /// segment's pattern (clip `skip` left out); `None` when no segment of either is phased.
-    pub fn error(&self, motions: &[PointClip], feet: &[usize], skip: Option<usize>) -> Option<f64> {
-        let d: Vec<f64> = patterns(motions, feet).iter().filter_map(|(_, p)| self.nearest(p, skip)).collect();
-        (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64)
+    pub fn error(&self, motions: &[PointClip], skip: Option<usize>) -> Option<f64> {
+        mean(&patterns(motions, &self.points).iter().filter_map(|(_, p)| self.nearest(p, skip)).collect::<Vec<f64>>())
     }
 
     /// Each clip against the others: mean over the clips' phased segments of the distance to
     /// the nearest segment of another clip.
     pub fn leave_one_out(&self) -> Option<f64> {
-        let d: Vec<f64> = self.clips.iter().filter_map(|(c, p)| self.nearest(p, Some(*c))).collect();
-        (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64)
+        mean(&self.clips.iter().filter_map(|(c, p)| self.nearest(p, Some(*c))).collect::<Vec<f64>>())
     }
 
     /// The error of feet whose phases are drawn uniformly at random (seeded): the chance level.
-    pub fn chance(&self, feet: usize, seed: u64) -> Option<f64> {
+    pub fn chance(&self, seed: u64) -> Option<f64> {
+        let feet = self.points.len();
         if self.clips.is_empty() || feet < 2 {
             return None;
         }
@@ -206,14 +212,14 @@ mod tests {
         let reference = Footfalls::new(&[walk(&lateral, 20.0, 120)], &FEET);
         // The same gait, started at another moment and a little faster: the same pattern.
         let same = [0.3, 0.8, 0.55, 0.05];
-        let e = reference.error(&[walk(&same, 18.0, 120)], &FEET, None).unwrap();
+        let e = reference.error(&[walk(&same, 18.0, 120)], None).unwrap();
         assert!(e < 0.02, "{e}");
         // A trot (diagonals together) differs by a quarter cycle on four of the six pairs.
         let trot = [0.0, 0.5, 0.5, 0.0];
-        let e = reference.error(&[walk(&trot, 20.0, 120)], &FEET, None).unwrap();
+        let e = reference.error(&[walk(&trot, 20.0, 120)], None).unwrap();
         assert!((e - 1.0 / 6.0).abs() < 0.02, "{e}");
         // Random phases sit between.
-        let chance = reference.chance(4, 1).unwrap();
+        let chance = reference.chance(1).unwrap();
         assert!((chance - 0.25).abs() < 0.03, "{chance}");
     }
 
@@ -222,10 +228,10 @@ mod tests {
         let still = walk(&[0.0, 0.5, 0.25, 0.75], 20.0, 120);
         let flat = PointClip::new(120, 12, (0..120).flat_map(|_| still.frame(0).to_vec()).collect()).unwrap();
         let reference = Footfalls::new(&[still], &FEET);
-        assert_eq!(reference.error(&[flat.clone()], &FEET, None), None);
+        assert_eq!(reference.error(&[flat.clone()], None), None);
         assert!(Footfalls::new(&[flat], &FEET).is_empty());
         // Too short for a segment.
-        assert!(patterns(&[walk(&[0.0, 0.5], 20.0, 20)], &[1, 2]).is_empty());
+        assert!(patterns(&[walk(&[0.0, 0.5], 20.0, 20)], &[0, 1]).is_empty());
     }
 
     #[test]

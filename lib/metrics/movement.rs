@@ -340,7 +340,7 @@ impl<'a> Reference<'a> {
     /// of a model that learned each leg's stride but not how the legs go together; `None`
     /// when the clips have no stretch with two feet swinging.
     pub fn footfall_chance(&self, seed: u64) -> Option<f64> {
-        self.footfalls.chance(self.clips[0].feet.iter().filter(|&&j| j >= 1 && j <= self.points[0].points()).count(), seed)
+        self.footfalls.chance(seed)
     }
 
     /// The clips' mean energy, sizes per second.
@@ -421,7 +421,7 @@ impl<'a> Reference<'a> {
             duty_factor: mean_of(stats.iter().filter_map(|s| s.0).collect()),
             mixed_contact: mean_of(stats.iter().filter_map(|s| s.1).collect()),
             alternation: pooled(&alternations),
-            footfall_error: self.footfalls.error(points, &motions[0].feet, skip),
+            footfall_error: self.footfalls.error(points, skip),
         })
     }
 
