@@ -31,6 +31,7 @@ METRICS = [
     ("mixed_contact", "mixed contact"),
     ("alternation", "alternation"),
     ("footfall_error", "footfall"),
+    ("swing", "swing"),
     ("coverage", "coverage %"),
     ("local_diversity", "local div"),
     ("inter_diversity", "inter div"),

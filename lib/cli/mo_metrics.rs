@@ -119,9 +119,10 @@ pub enum Command {
     /// pose, random crops): motion energy (joint speed relative to the root, body sizes per
     /// second) and its ratio to the clips', the distance of each pose to the nearest clip pose,
     /// coverage with thresholds calibrated on the clips, foot contact (duty factor, share of
-    /// frames with some feet down and some up), alternation, and the footfall error: how far
-    /// the feet's phases against each other lie from the clips', next to feet phased at random
-    /// (`footfall_chance`). Definitions: docs/metrics.md.
+    /// frames with some feet down and some up), alternation, the footfall error: how far the
+    /// feet's phases against each other lie from the clips', next to feet phased at random
+    /// (`footfall_chance`), and swing: whether lifted feet move with the body's travel (1) or
+    /// against it (-1, legs played backwards). Definitions: docs/metrics.md.
     Generation {
         /// Ground-truth clips (files or directories).
         #[arg(long, value_name = "PATH", required = true, num_args = 1..)]

@@ -27,6 +27,10 @@
 //!
 //! * footfall error: how far the feet's phases against each other lie from the nearest
 //!   stretch of the clips (`footfall`), next to the level of feet phased at random.
+//! * swing: whether feet are lifted while they move with the body's travel (+1, as in every
+//!   walk) or against it (-1: the legs' cycle played backwards under a body that goes
+//!   forwards, a moonwalk). A model that has not learnt which way time runs makes such legs,
+//!   with every pose right.
 //!
 //! Every loop over frames or windows is bounded by caps on the reference frames and windows
 //! (strided evenly), so a 15,000-frame capture scores in seconds; every result is the same at
@@ -97,6 +101,9 @@ pub struct Movement {
     /// clip stretch's (`footfall`; `None`: no stretch of these motions or of the clips has two
     /// feet swinging).
     pub footfall_error: Option<f64>,
+    /// From -1 to 1: whether lifted feet move with the root's travel or against it, pooled
+    /// over the motions (`swing`; `None`: no feet, or the root does not travel).
+    pub swing: Option<f64>,
 }
 
 /// A skeleton's clips, prepared once: world clips for energy, contact and poses, AnyTop point
@@ -238,11 +245,55 @@ fn alternation_parts(points: &PointClip, feet: &[usize]) -> Option<(f64, f64)> {
     (total > 1e-6).then_some((opposed * frames as f64, total * frames as f64))
 }
 
+/// Whether a motion's feet are lifted while they move with the root's travel (+1) or against
+/// it (-1). Over each step from one frame to the next in which the root travels horizontally
+/// at least 5% of the body size per second, and each foot (not the root): h = the foot's height
+/// above its lowest in the motion, v = its horizontal displacement relative to the root along
+/// the root's direction of travel in that step. The result is Σ h·v / Σ h·|v|. A walk lifts a
+/// foot to carry it forward and pushes back while it is down, so it scores near 1; its legs
+/// played backwards under a root that goes forwards score near -1, and feet that swing
+/// forwards and backwards alike while lifted near 0. `None` without feet, or when the root
+/// does not travel (an idle clip) or no foot moves.
+pub fn swing(clip: &WorldClip) -> Option<f64> {
+    swing_parts(clip).map(|(with, all)| with / all)
+}
+
+/// Σ h·v and Σ h·|v| of `swing`, so that several motions pool by how far and how long their
+/// feet swing; `None` where `swing` is.
+fn swing_parts(clip: &WorldClip) -> Option<(f64, f64)> {
+    let (frames, joints) = (clip.frames, clip.joints);
+    let feet: Vec<usize> = clip.feet.iter().copied().filter(|&j| j > 0 && j < joints).collect();
+    if feet.is_empty() || frames < 2 || !(clip.scale > 0.0) || !(clip.fps > 0.0) || clip.positions.len() < frames * joints {
+        return None;
+    }
+    let min_step = 0.05 * clip.scale / clip.fps;
+    let lowest: Vec<f64> = feet.iter().map(|&j| (0..frames).map(|f| clip.at(f, j).y).fold(f64::INFINITY, f64::min)).collect();
+    let (mut with, mut all) = (0.0, 0.0);
+    for f in 0..frames - 1 {
+        let (r0, r1) = (clip.at(f, 0), clip.at(f + 1, 0));
+        let travel = glam::DVec2::new(r1.x - r0.x, r1.z - r0.z);
+        // `!(>=)` also skips a NaN step.
+        if !(travel.length() >= min_step) {
+            continue;
+        }
+        let along = travel.normalize();
+        for (&j, low) in feet.iter().zip(&lowest) {
+            let moved = (clip.at(f + 1, j) - r1) - (clip.at(f, j) - r0);
+            let v = moved.x * along.x + moved.z * along.y;
+            let h = 0.5 * (clip.at(f, j).y + clip.at(f + 1, j).y) - low;
+            with += h * v;
+            all += h * v.abs();
+        }
+    }
+    (all.is_finite() && all > 1e-12 * clip.scale * clip.scale).then_some((with, all))
+}
+
 /// One clip's part of the clips' baseline: nearest pose against the other clips, duty factor,
 /// mixed contact, alternation's parts.
 type ClipParts = (f64, Option<f64>, Option<f64>, Option<(f64, f64)>);
 
-/// Alternation over several motions: their `alternation_parts` pooled.
+/// Alternation (or swing) over several motions: their `alternation_parts` (`swing_parts`)
+/// pooled, the first sums over the second.
 fn pooled(parts: &[(f64, f64)]) -> Option<f64> {
     let (opposed, total) = parts.iter().fold((0.0, 0.0), |(o, t), p| (o + p.0, t + p.1));
     (!parts.is_empty()).then(|| opposed / total)
@@ -412,6 +463,7 @@ impl<'a> Reference<'a> {
         let stats: Vec<(Option<f64>, Option<f64>)> = motions.iter().map(|c| contact_stats(c, &self.opts.contact)).collect();
         let mean_of = |v: Vec<f64>| if v.is_empty() { None } else { Some(v.iter().sum::<f64>() / v.len() as f64) };
         let alternations: Vec<(f64, f64)> = motions.iter().zip(points).filter_map(|(c, p)| alternation_parts(p, &c.feet)).collect();
+        let swings: Vec<(f64, f64)> = motions.iter().filter_map(swing_parts).collect();
         Ok(Movement {
             energy: mean,
             energy_ratio: ratio(mean),
@@ -422,6 +474,7 @@ impl<'a> Reference<'a> {
             mixed_contact: mean_of(stats.iter().filter_map(|s| s.1).collect()),
             alternation: pooled(&alternations),
             footfall_error: self.footfalls.error(points, skip),
+            swing: pooled(&swings),
         })
     }
 
@@ -469,6 +522,7 @@ impl<'a> Reference<'a> {
             mixed_contact: avg_opt(&|p| p.2),
             alternation: pooled(&parts.iter().filter_map(|p| p.3).collect::<Vec<_>>()),
             footfall_error: self.footfalls.leave_one_out(),
+            swing: pooled(&self.clips.iter().filter_map(swing_parts).collect::<Vec<_>>()),
         })
     }
 
@@ -583,8 +637,10 @@ mod tests {
         // The walk itself alternates its feet.
         let own = r.clips_baseline().unwrap();
         assert!(own.mixed_contact.unwrap() > 0.3, "{own:?}");
-        // A statue's feet do not move, so they neither alternate nor swing together.
+        // A statue's feet do not move, so they neither alternate nor swing together, and its
+        // root does not travel.
         assert_eq!(m.alternation, None);
+        assert_eq!(m.swing, None);
         assert!(own.alternation.unwrap() > 0.6, "{own:?}");
         // Pooled, a motion whose feet barely move counts for little: the walk next to a clip
         // whose two feet sway together by a ten-thousandth of a unit is still a walk.
@@ -627,8 +683,58 @@ mod tests {
         assert_eq!(alternation(&lift, &feet), None);
     }
 
+    /// The walk's legs played backwards under its root going forwards (a moonwalk): the walk
+    /// played backwards whole, but with the root's horizontal travel of the walk played
+    /// forwards, so every pose and every height is one of the walk's.
+    fn moonwalk(clip: &WorldClip) -> WorldClip {
+        let n = clip.frames;
+        let positions = (0..n)
+            .flat_map(|f| {
+                let back = n - 1 - f;
+                let (ahead, behind) = (clip.at(f, 0), clip.at(back, 0));
+                let shift = DVec3::new(ahead.x - behind.x, 0.0, ahead.z - behind.z);
+                (0..clip.joints).map(move |j| clip.at(back, j) + shift)
+            })
+            .collect();
+        WorldClip { positions, ..clip.clone() }
+    }
+
+    #[test]
+    fn swing_tells_a_walk_from_its_legs_played_backwards() {
+        let (clip, _) = walk();
+        let forward = swing(&clip).unwrap();
+        assert!(forward > 0.8, "{forward}");
+        let back = swing(&moonwalk(&clip)).unwrap();
+        assert!(back < -0.8, "{back} (the walk: {forward})");
+        // The whole walk played backwards is a walk backwards: its feet still swing with the
+        // travel, by the same amount.
+        let reversed = WorldClip { positions: (0..clip.frames).rev().flat_map(|f| clip.frame(f).to_vec()).collect(), ..clip.clone() };
+        let backwards = swing(&reversed).unwrap();
+        assert!((backwards - forward).abs() < 1e-9, "{backwards} vs {forward}");
+        // The same legs on a root that stays where it is: no travel, no value.
+        let in_place = WorldClip {
+            positions: (0..clip.frames)
+                .flat_map(|f| {
+                    let r = clip.at(f, 0);
+                    clip.frame(f).iter().map(move |p| *p - DVec3::new(r.x, 0.0, r.z)).collect::<Vec<_>>()
+                })
+                .collect(),
+            ..clip.clone()
+        };
+        assert_eq!(swing(&in_place), None);
+        // Through the scorer: the moonwalk has the walk's poses and the opposite swing.
+        let points = vec![PointClip::from_clip(&clip).unwrap()];
+        let clips = vec![clip];
+        let r = Reference::new(&clips, &points, &MovementOptions::default()).unwrap();
+        let moon = vec![moonwalk(&clips[0])];
+        let m = r.score(&moon, &[PointClip::from_clip(&moon[0]).unwrap()], None).unwrap();
+        assert!(m.nearest_pose < 1e-9, "{m:?}");
+        assert!(m.swing.unwrap() < -0.8, "{m:?}");
+        assert!(r.clips_baseline().unwrap().swing.unwrap() > 0.8);
+    }
+
     /// A hip that stays put and a foot swinging under it at `hz`, 30 fps.
-    fn swing(frames: usize, hz: f64) -> WorldClip {
+    fn pendulum(frames: usize, hz: f64) -> WorldClip {
         let positions = (0..frames)
             .flat_map(|f| {
                 let x = 0.3 * (std::f64::consts::TAU * hz * f as f64 / 30.0).sin();
@@ -650,7 +756,7 @@ mod tests {
     #[test]
     fn a_sped_up_copy_has_twice_the_energy() {
         // A slow swing, which the 5-frame average leaves almost whole at both speeds.
-        let slow = swing(480, 0.25);
+        let slow = pendulum(480, 0.25);
         let fast = faster(&slow, 2);
         assert!((energy(&fast, 5) / energy(&slow, 5) - 2.0).abs() < 0.05, "{} vs {}", energy(&fast, 5), energy(&slow, 5));
         // The zoo walk through the whole scorer: its quick foot motion loses more to the

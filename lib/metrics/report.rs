@@ -273,6 +273,7 @@ pub fn generation_report(gt: &[Clip], gen: &[Clip], section: &AnyTopSection, opt
             ("alternation", "share of the feet's horizontal swing that is against a partner foot, not with it (1: a walk's left against right, 0: all together)"),
             ("footfall_error", "cycles, 0-0.5: the feet's phases against each other, from the nearest clip stretch's (0: the clips' footfall order)"),
             ("footfall_chance", "cycles: footfall_error of feet phased at random"),
+            ("swing", "-1 to 1: lifted feet move with the root's travel (1, a walk) or against it (-1, the legs played backwards)"),
             ("local_diversity", "mean joint distance, AnyTop units (mean SMPL bone = 0.209)"),
             ("global_diversity", "mean joint distance per frame, AnyTop units"),
             ("inter_diversity", "mean joint distance, AnyTop units"),
