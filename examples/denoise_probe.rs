@@ -263,6 +263,7 @@ fn trajectory(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crop: &mena
     println!("|---|---|---|---|");
     let (mut far, mut moving) = (vec![0.0; steps.len()], vec![0.0; steps.len()]);
     let mut kept = vec![0.0; steps.len()];
+    let clip = Features { frames: FRAMES, joints: j, dims: d, data: reference.clone() };
     for seed in 0..SEEDS {
         let noise = menagerie::rng::gaussian(&mut SplitMix64::new(100 + seed), FRAMES * j * d);
         for (i, x0) in run(noise.clone(), 0)?.iter().enumerate() {
@@ -270,7 +271,6 @@ fn trajectory(model: &Denoiser, set: &TrainSet, schedule: &Schedule, crop: &mena
             moving[i] += motion(x0, FRAMES) / clip_motion.max(1e-12) / SEEDS as f64;
         }
         for (from, st) in steps.iter().enumerate() {
-            let clip = Features { frames: FRAMES, joints: j, dims: d, data: reference.clone() };
             let last = run(noised(&clip, &noise, schedule.noise_coefficients(st.t)).data, from)?.pop().unwrap_or_default();
             kept[from] += distance(&last) / SEEDS as f64;
         }

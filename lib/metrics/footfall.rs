@@ -45,7 +45,7 @@ pub struct Pattern {
 }
 
 /// Mean of `d`; `None` when it is empty.
-fn mean(d: &[f64]) -> Option<f64> {
+pub(super) fn mean(d: &[f64]) -> Option<f64> {
     (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64)
 }
 

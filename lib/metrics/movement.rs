@@ -36,7 +36,7 @@
 //! (strided evenly), so a 15,000-frame capture scores in seconds; every result is the same at
 //! any thread count (parallel loops fill per-item slots, reductions run in order).
 
-use super::footfall::Footfalls;
+use super::footfall::{self, Footfalls};
 use super::generation::PointClip;
 use super::physics::{contacts, Ground, PhysicsOptions};
 use super::{MetricError, WorldClip};
@@ -461,7 +461,6 @@ impl<'a> Reference<'a> {
         let frames: usize = motions.iter().map(|c| c.frames).sum();
         let pose_sum: f64 = motions.iter().map(|c| self.nearest_pose(c, skip) * c.frames as f64).sum();
         let stats: Vec<(Option<f64>, Option<f64>)> = motions.iter().map(|c| contact_stats(c, &self.opts.contact)).collect();
-        let mean_of = |v: Vec<f64>| if v.is_empty() { None } else { Some(v.iter().sum::<f64>() / v.len() as f64) };
         let alternations: Vec<(f64, f64)> = motions.iter().zip(points).filter_map(|(c, p)| alternation_parts(p, &c.feet)).collect();
         let swings: Vec<(f64, f64)> = motions.iter().filter_map(swing_parts).collect();
         Ok(Movement {
@@ -470,8 +469,8 @@ impl<'a> Reference<'a> {
             energy_ratio_range: (ratio(lo), ratio(hi)),
             nearest_pose: pose_sum / frames.max(1) as f64,
             calibrated_coverage: self.coverage(points, skip),
-            duty_factor: mean_of(stats.iter().filter_map(|s| s.0).collect()),
-            mixed_contact: mean_of(stats.iter().filter_map(|s| s.1).collect()),
+            duty_factor: footfall::mean(&stats.iter().filter_map(|s| s.0).collect::<Vec<f64>>()),
+            mixed_contact: footfall::mean(&stats.iter().filter_map(|s| s.1).collect::<Vec<f64>>()),
             alternation: pooled(&alternations),
             footfall_error: self.footfalls.error(points, skip),
             swing: pooled(&swings),
