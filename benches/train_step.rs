@@ -129,6 +129,7 @@ fn main() {
         noise_shift: None,
         position_jitter: None,
         shift_taper: None,
+        still_weight: None,
         weighting: None,
         augment: 0.0,
         augment_variants: 0,

@@ -23,7 +23,7 @@ _mo__train() {
 
     case "${cmd}" in
         mo__train)
-            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --lambda-foot --augment --augment-variants --fallback-stats --loss-units --rest-token --ema --noise-shift --loss-weighting --position-jitter --shift-taper --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --animation --fps --help --version"
+            opts="-o -q -v -h -V --out --preset --steps --minutes --init --batch --crop --arch --lambda-kl --lambda-cycle --lr --lambda-geo --lambda-vel --lambda-foot --augment --augment-variants --fallback-stats --loss-units --rest-token --ema --noise-shift --loss-weighting --position-jitter --shift-taper --still-weight --checkpoint-minutes --resume --output --seed --quiet --verbose --threads --animation --fps --help --version"
             if [[ ${cur} == -* || ${COMP_CWORD} -eq 1 ]] ; then
                 COMPREPLY=( $(compgen -W "${opts}" -- "${cur}") )
                 return 0
@@ -123,6 +123,10 @@ _mo__train() {
                     ;;
                 --shift-taper)
                     COMPREPLY=($(compgen -W "true false" -- "${cur}"))
+                    return 0
+                    ;;
+                --still-weight)
+                    COMPREPLY=($(compgen -f "${cur}"))
                     return 0
                     ;;
                 --checkpoint-minutes)

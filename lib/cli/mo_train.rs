@@ -208,6 +208,14 @@ pub struct Args {
     /// model goes on learning under the new schedule].
     #[arg(long, value_name = "BOOL")]
     pub shift_taper: Option<bool>,
+    /// anytop: draw a still clip (one whose mean frame-to-frame change is under 0.15 of its
+    /// skeleton's most moving clip's, such as an idle) W times as often as a moving clip of the
+    /// same skeleton. On one zoo quadruped's five clips, its standing idle clip drawn as often
+    /// as the others left the samples' fore legs leading at random, and without it they led as
+    /// the clips' (models/zoo-small-next/MODEL_CARD.md, "Which fore leg leads") [default: 1 for
+    /// a new run; a fine-tune or a resumed run keeps its model's, unless this is given].
+    #[arg(long, value_name = "W", value_parser = bounds::non_negative(1.0))]
+    pub still_weight: Option<f64>,
     /// Save a checkpoint at least this often.
     #[arg(long, value_name = "MIN", default_value_t = 5.0, value_parser = bounds::positive(bounds::MAX_CHECKPOINT_MINUTES))]
     pub checkpoint_minutes: f64,
@@ -398,6 +406,7 @@ fn train_anytop(args: &Args, resolved: &Resolved, device: &Device) -> anyhow::Re
         noise_shift: args.noise_shift,
         position_jitter: args.position_jitter.map(|n| n as usize),
         shift_taper: args.shift_taper,
+        still_weight: args.still_weight,
         weighting: args.loss_weighting,
     };
     // Before any loading: a new run (fresh or fine-tune) never overwrites a checkpoint.

@@ -204,6 +204,10 @@ pub struct CheckpointInfo {
     /// (`data::Crop::position`); 0 in checkpoints written before it existed (every crop at 0).
     #[serde(default)]
     pub position_jitter: usize,
+    /// How often still clips were drawn against moving ones (`data::still_clips`); 1 (alike) in
+    /// checkpoints written before it existed.
+    #[serde(default = "alike", skip_serializing_if = "is_alike")]
+    pub still_weight: f64,
     /// How the diffusion steps weighed in the loss (`train::Weighting`); x0 in checkpoints
     /// written before it existed.
     #[serde(default = "plain_x0", skip_serializing_if = "is_plain_x0")]
@@ -221,6 +225,14 @@ fn is_no_fallback(v: &crate::diffusion::data::FallbackStats) -> bool {
 
 fn is_normalised_units(v: &crate::diffusion::data::LossUnits) -> bool {
     *v == crate::diffusion::data::LossUnits::Normalised
+}
+
+fn alike() -> f64 {
+    1.0
+}
+
+fn is_alike(w: &f64) -> bool {
+    *w == 1.0
 }
 
 fn no_shift() -> f64 {

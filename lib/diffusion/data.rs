@@ -156,6 +156,9 @@ pub struct TrainSet {
     /// A crop's temporal positions start at a random offset in `0..=position_jitter` (0: every
     /// crop starts at 0), drawn apart from where the crop lies in its clip; see `Crop::position`.
     pub position_jitter: usize,
+    /// How often a still clip is drawn against a moving one of its skeleton (`still_clips`):
+    /// 1 draws every clip alike.
+    pub still_weight: f64,
     /// What every rest token was normalised by, when not its skeleton's statistics.
     pub rest_norm: Option<RestNorm>,
 }
@@ -485,7 +488,10 @@ impl TrainSet {
         if skeletons.is_empty() {
             return Err(DataError::TooShort { clip: first_short.unwrap_or_default() });
         }
-        Ok((TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants, position_jitter: 0, rest_norm }, dropped))
+        Ok((
+            TrainSet { skeletons, augmented, augment_probability: aug.probability, skipped_variants, position_jitter: 0, still_weight: 1.0, rest_norm },
+            dropped,
+        ))
     }
 
     /// The skeleton (original or augmented variant) a crop comes from.
@@ -544,7 +550,7 @@ impl TrainSet {
                     Some(v) => &variants[v],
                     None => &self.skeletons[s],
                 };
-                let c = rng.below(sk.clips.len());
+                let c = if self.still_weight == 1.0 { rng.below(sk.clips.len()) } else { draw_weighted(rng, &still_clips(sk), self.still_weight) };
                 let clip = &sk.clips[c];
                 let len = clip.frames.min(frames);
                 let start = rng.below(clip.frames - len + 1);
@@ -561,6 +567,47 @@ impl TrainSet {
         let width = clip.joints * clip.dims;
         Features { frames: crop.frames, joints: clip.joints, dims: clip.dims, data: clip.data[crop.start * width..(crop.start + crop.frames) * width].to_vec() }
     }
+}
+
+/// A clip is still when its mean absolute frame-to-frame change (normalised features) is under
+/// this fraction of its skeleton's most moving clip's. The zoo's idle clips read 0.05 of their
+/// run's on this scale in BVH channels (0.10 against 2.22 degrees per frame on
+/// `quadruped_v0`), its walk-stop-walk clips 0.32.
+pub const STILL_FRACTION: f64 = 0.15;
+
+/// Which clips of `sk` are still (`STILL_FRACTION`). Worked out at each draw: one pass over the
+/// skeleton's features is small next to a training step.
+pub fn still_clips(sk: &SkeletonData) -> Vec<bool> {
+    let motion: Vec<f64> = sk
+        .clips
+        .iter()
+        .map(|f| {
+            let w = f.joints * f.dims;
+            let n = f.data.len().saturating_sub(w).max(1);
+            f.data.iter().zip(f.data.iter().skip(w)).map(|(a, b)| (b - a).abs() as f64).sum::<f64>() / n as f64
+        })
+        .collect();
+    let most = motion.iter().copied().fold(0.0, f64::max);
+    motion.iter().map(|&m| m < STILL_FRACTION * most).collect()
+}
+
+/// An index into `still`, a still entry weighing `weight` and a moving one 1; uniform when all
+/// weigh alike (all still, or none).
+fn draw_weighted(rng: &mut SplitMix64, still: &[bool], weight: f64) -> usize {
+    let stills = still.iter().filter(|&&s| s).count();
+    if stills == 0 || stills == still.len() {
+        return rng.below(still.len());
+    }
+    let total = (still.len() - stills) as f64 + weight * stills as f64;
+    let mut u = rng.unit() * total;
+    for (i, &s) in still.iter().enumerate() {
+        u -= if s { weight } else { 1.0 };
+        if u < 0.0 {
+            return i;
+        }
+    }
+    // Rounding can leave u at a hair above 0: the last entry that weighs anything.
+    still.iter().rposition(|&s| !s || weight > 0.0).unwrap_or(0)
 }
 
 /// Where a training crop comes from.
@@ -851,6 +898,59 @@ mod tests {
         assert_eq!(share(&set), 1.0);
         aug.probability = 1.5;
         assert!(matches!(TrainSet::build(zoo(), names, topology::DEFAULT_DMAX, &aug), Err(DataError::Probability(_))));
+    }
+
+    /// One zoo quadruped's five actions, as the zoo writes them (`synth::training_clip`).
+    fn quadruped_actions() -> Vec<Clip> {
+        use crate::synth::{training_clip, Action};
+        [Action::Walk, Action::Run, Action::Idle, Action::Turn, Action::WalkStopWalk]
+            .iter()
+            .map(|&a| {
+                let c = training_clip("quadruped", 0, a, 1, 160).unwrap();
+                Clip { name: format!("quadruped/{}.bvh", a.name()), skeleton: c.skeleton, motion: c.motion }
+            })
+            .collect()
+    }
+
+    /// Of the zoo quadruped's actions only the idle is still; weight 1 draws the clips alike
+    /// with the stream runs had before the weight, 0 never draws the idle, 0.25 draws it about
+    /// a quarter as often as each moving clip.
+    #[test]
+    fn the_still_weight_draws_the_idle_clip_less_often() {
+        let names = NameTable::builtin().unwrap();
+        let (mut set, _) = TrainSet::build(quadruped_actions(), names, topology::DEFAULT_DMAX, &Augmentation::none()).unwrap();
+        let sk = &set.skeletons[0];
+        let idle = sk.clip_names.iter().position(|n| n.contains("idle")).unwrap();
+        let still = still_clips(sk);
+        assert_eq!(still.iter().filter(|&&s| s).count(), 1, "{still:?} for {:?}", sk.clip_names);
+        assert!(still[idle]);
+        let share = |set: &TrainSet| set.sample(&mut SplitMix64::new(9), 4000, 40).iter().filter(|c| c.clip == idle).count() as f64 / 4000.0;
+        let alike = set.sample(&mut SplitMix64::new(9), 300, 40);
+        assert!((share(&set) - 0.2).abs() < 0.03, "{}", share(&set));
+        set.still_weight = 0.0;
+        assert_eq!(share(&set), 0.0);
+        set.still_weight = 0.25;
+        // 0.25 / (4 + 0.25) of the draws.
+        assert!((share(&set) - 0.25 / 4.25).abs() < 0.02, "{}", share(&set));
+        set.still_weight = 1.0;
+        assert_eq!(set.sample(&mut SplitMix64::new(9), 300, 40), alike);
+    }
+
+    /// All still or none: every clip alike, whatever the weight.
+    #[test]
+    fn a_weighted_draw_is_uniform_when_all_clips_weigh_alike() {
+        let mut rng = SplitMix64::new(3);
+        let mut counts = [0usize; 3];
+        for _ in 0..3000 {
+            counts[draw_weighted(&mut rng, &[true, true, true], 0.0)] += 1;
+        }
+        assert!(counts.iter().all(|&c| (800..1200).contains(&c)), "{counts:?}");
+        let mut counts = [0usize; 3];
+        for _ in 0..3000 {
+            counts[draw_weighted(&mut rng, &[false, true, false], 0.0)] += 1;
+        }
+        assert_eq!(counts[1], 0, "{counts:?}");
+        assert!(counts[0] > 1300 && counts[2] > 1300, "{counts:?}");
     }
 
     /// Off, every crop sits at position 0 and the draw stream is the one runs had before the

@@ -284,6 +284,10 @@ pub struct AnyTopOptions {
     /// `DEFAULT_SHIFT_TAPER` for a new run, the model's for a fine-tune or a resumed run; given,
     /// a resumed run continues under the new schedule.
     pub shift_taper: Option<bool>,
+    /// How often a still clip is drawn against a moving one of its skeleton
+    /// (`data::still_clips`): none = 1 (alike) for a new run, the model's for a fine-tune or a
+    /// resumed run.
+    pub still_weight: Option<f64>,
 }
 
 /// Whether a new run tapers its noise shift: no, the taper made a 1-skeleton proxy's samples
@@ -412,6 +416,7 @@ impl AnyTopResume {
             || i.loss_units != opts.loss_units
             || i.rest_norm.is_some() != (opts.rest_token == RestToken::Global)
             || opts.position_jitter.is_some_and(|j| j != i.position_jitter)
+            || opts.still_weight.is_some_and(|w| w != i.still_weight)
     }
 
     /// The loss weighting the checkpoint was trained with, when `opts` asks for another.
@@ -473,6 +478,7 @@ impl AnyTopTrainer {
             ema: 0.0,
             noise_shift: base.map_or(DEFAULT_NOISE_SHIFT, |b| b.noise_shift),
             position_jitter: base.map_or(DEFAULT_POSITION_JITTER, |b| b.position_jitter),
+            still_weight: base.map_or(1.0, |b| b.still_weight),
             shift_taper: base.map_or(DEFAULT_SHIFT_TAPER, |b| b.shift_taper),
             weighting: base.map_or(DEFAULT_WEIGHTING, |b| b.weighting),
             init: None,
@@ -501,6 +507,9 @@ impl AnyTopTrainer {
         }
         if let Some(jitter) = opts.position_jitter {
             info.position_jitter = jitter;
+        }
+        if let Some(weight) = opts.still_weight {
+            info.still_weight = weight;
         }
         if let Some(weighting) = opts.weighting {
             info.weighting = weighting;
@@ -549,6 +558,7 @@ impl AnyTopTrainer {
         }
         info.ema = opts.ema;
         set.position_jitter = info.position_jitter;
+        set.still_weight = info.still_weight;
         Ok(AnyTopTrainer {
             out: out.to_path_buf(),
             info,

@@ -289,6 +289,33 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     assert!(!other.join("checkpoint.json").exists());
 }
 
+/// A new run draws every clip alike and records nothing; a resumed run given --still-weight
+/// records it (and says the draws differ), the next resume keeps it; a weight outside 0..=1 is
+/// refused before any training.
+#[test]
+fn the_still_weight_is_recorded_and_kept_on_resume() {
+    let dir = tempdir("train-still");
+    let data = data(&dir);
+    let out = dir.join("model");
+    ok(&run("mo-train", &train_args(&data, &out, "2"), None), "new run");
+    assert!(info(&out).get("still_weight").is_none(), "{}", info(&out));
+    let mut args = train_args(&data, &out, "3");
+    args.extend(["--resume", "--still-weight", "0.25"]);
+    let changed = run("mo-train", &args, None);
+    ok(&changed, "resume with a still weight");
+    assert!(String::from_utf8_lossy(&changed.stderr).contains("differ from the checkpoint's"), "{}", String::from_utf8_lossy(&changed.stderr));
+    assert_eq!(info(&out)["still_weight"].as_f64(), Some(0.25));
+    let mut args = train_args(&data, &out, "4");
+    args.push("--resume");
+    ok(&run("mo-train", &args, None), "resume");
+    assert_eq!(info(&out)["still_weight"].as_f64(), Some(0.25));
+    let other = dir.join("other");
+    let mut args = train_args(&data, &other, "1");
+    args.extend(["--still-weight", "2"]);
+    common::check_failure("mo-train", "still weight 2", &run("mo-train", &args, None), "--still-weight");
+    assert!(!other.join("checkpoint.json").exists());
+}
+
 /// A new run records the default position jitter, a resumed run keeps its checkpoint's (0 for
 /// checkpoints written before it existed) unless it is given again, and the jitter changes
 /// what is learnt.
