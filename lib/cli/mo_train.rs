@@ -210,10 +210,11 @@ pub struct Args {
     pub shift_taper: Option<bool>,
     /// anytop: draw a still clip (one whose mean frame-to-frame change is under 0.15 of its
     /// skeleton's most moving clip's, such as an idle) W times as often as a moving clip of the
-    /// same skeleton. On one zoo quadruped's five clips, its standing idle clip drawn as often
-    /// as the others left the samples' fore legs leading at random, and without it they led as
-    /// the clips' (models/zoo-small-next/MODEL_CARD.md, "Which fore leg leads") [default: 1 for
-    /// a new run; a fine-tune or a resumed run keeps its model's, unless this is given].
+    /// same skeleton; 0 leaves them out. On one zoo quadruped's five clips, the standing idle
+    /// drawn as often as the others, or a quarter as often, left the samples' fore legs leading
+    /// at random; left out, they led as the clips' (models/zoo-small-next/MODEL_CARD.md, "Which
+    /// fore leg leads") [default: 1 for a new run; a fine-tune or a resumed run keeps its
+    /// model's, unless this is given].
     #[arg(long, value_name = "W", value_parser = bounds::non_negative(1.0))]
     pub still_weight: Option<f64>,
     /// Save a checkpoint at least this often.
