@@ -34,6 +34,7 @@ use crate::rng::SplitMix64;
 use crate::skeleton::{topology, Skeleton};
 use std::borrow::Cow;
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// Clips shorter than this (in feature frames) are left out, as the reference does.
 pub const MIN_FRAMES: usize = 20;
@@ -66,6 +67,9 @@ pub struct SkeletonData {
     /// loss: `None` counts every value alike; with the fallback, (fallback spread / own spread)²,
     /// so the error is measured in the skeleton's own units (see `LOSS_WEIGHT_RANGE`).
     pub loss_weights: Option<Vec<f32>>,
+    /// `still_clips`, worked out at the first draw that weighs them (`TrainSet::still_weight`):
+    /// not in `prepare`, because the clips are normalised in place after it.
+    still: OnceLock<Vec<bool>>,
 }
 
 /// Skeletal augmentation settings (see the module doc).
@@ -300,6 +304,7 @@ fn prepare<'a>(
         clips: features,
         clip_names,
         loss_weights: None,
+        still: OnceLock::new(),
     }))
 }
 
@@ -550,7 +555,11 @@ impl TrainSet {
                     Some(v) => &variants[v],
                     None => &self.skeletons[s],
                 };
-                let c = if self.still_weight == 1.0 { rng.below(sk.clips.len()) } else { draw_weighted(rng, &still_clips(sk), self.still_weight) };
+                let c = if self.still_weight == 1.0 {
+                    rng.below(sk.clips.len())
+                } else {
+                    draw_weighted(rng, sk.still.get_or_init(|| still_clips(sk)), self.still_weight)
+                };
                 let clip = &sk.clips[c];
                 let len = clip.frames.min(frames);
                 let start = rng.below(clip.frames - len + 1);
@@ -575,8 +584,7 @@ impl TrainSet {
 /// 0.71 (0.32); in features only the idle is still (`tests`).
 pub const STILL_FRACTION: f64 = 0.15;
 
-/// Which clips of `sk` are still (`STILL_FRACTION`). Worked out at each draw: one pass over the
-/// skeleton's features is small next to a training step.
+/// Which clips of `sk` are still (`STILL_FRACTION`).
 pub fn still_clips(sk: &SkeletonData) -> Vec<bool> {
     let motion: Vec<f64> = sk
         .clips
@@ -913,8 +921,8 @@ mod tests {
     }
 
     /// Of the zoo quadruped's actions only the idle is still; weight 1 draws the clips alike
-    /// with the stream runs had before the weight, 0 never draws the idle, 0.25 draws it about
-    /// a quarter as often as each moving clip.
+    /// (and the same crops after other weights were used), 0 never draws the idle, 0.25 draws
+    /// it about a quarter as often as each moving clip.
     #[test]
     fn the_still_weight_draws_the_idle_clip_less_often() {
         let names = NameTable::builtin().unwrap();
