@@ -382,7 +382,12 @@ pub(super) fn exp(x: f32) -> f32 {
     let n = (xc * std::f32::consts::LOG2_E).round();
     let r = xc - n * 0.693_145_75 - n * 1.428_606_8e-6;
     let p = 1.0 + r * (1.0 + r * (0.5 + r * (1.0 / 6.0 + r * (1.0 / 24.0 + r * (1.0 / 120.0 + r * (1.0 / 720.0))))));
-    let scale = f32::from_bits(((n as i32 + 127) as u32) << 23);
+    // `n as i32` would saturate, and that check is done lane by lane in scalar code (it made
+    // this function's loops scalar at their core). n is finite here (`xc` is never NaN) and at
+    // most 128 after the `min`, so the unchecked conversion is exact and vectorises.
+    // SAFETY: n is an integer-valued finite f32 in [-126, 128], representable as i32.
+    let n = unsafe { n.min(128.0).to_int_unchecked::<i32>() };
+    let scale = f32::from_bits(((n + 127) as u32) << 23);
     if x < -87.0 {
         0.0
     } else {

@@ -203,6 +203,12 @@ fn fast_exp_is_accurate_and_exactly_zero_for_masked_keys() {
     assert_eq!(super::exp(0.0), 1.0);
     assert_eq!(super::exp(f32::NEG_INFINITY), 0.0);
     assert_eq!(super::exp(-1e9), 0.0);
+    // Outside the softmax's range the exponent is clamped before its (unchecked) conversion:
+    // still accurate up to f32's largest power of two, infinite beyond it.
+    for x in [0.5f32, 10.0, 60.0, 88.0] {
+        assert!(((super::exp(x) - x.exp()) / x.exp()).abs() < 1e-6, "e^{x}");
+    }
+    assert_eq!(super::exp(200.0), f32::INFINITY);
 }
 
 #[test]
