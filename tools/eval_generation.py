@@ -66,6 +66,9 @@ def metrics(bindir, folder, generated, skeleton):
     movement = full["movement"]
     out = {k: movement["samples"][k] if k in movement["samples"] else report[k]["mean"] for k, _ in METRICS}
     out["baselines"] = dict(movement["baselines"])
+    # Which clips' windows are covered (the clip file names, then each one's percent).
+    names = [os.path.basename(c) for c in movement.get("clips", [])]
+    out["by_clip"] = list(zip(names, movement["samples"].get("calibrated_coverage_by_clip", [])))
     # The footfall error of feet phased at random: a baseline row of its own.
     out["baselines"]["random_phases"] = {"footfall_error": movement.get("footfall_chance")}
     files = clips(generated) if os.path.isdir(generated) else []
@@ -139,11 +142,13 @@ def main():
     ap.add_argument("--sampler", default="ddim")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--steps-table", metavar="FOLDER", help="also: quality and time against sampling steps here")
+    ap.add_argument("--by-clip", action="store_true", help="also: each generator's calibrated coverage of each clip, in a second table")
     args = ap.parse_args()
     models = [m.split("=", 1) for m in args.model]
     tmp = tempfile.mkdtemp(prefix="menagerie-eval-")
     print(row(["skeleton", "generator"] + [h for _, h in METRICS + PHYSICS]))
     print(row(["---"] * (2 + len(METRICS) + len(PHYSICS))))
+    by_clip = []
     for folder in args.skeletons:
         name = os.path.basename(folder.rstrip("/"))
         skeleton = clips(folder)[0]
@@ -164,6 +169,14 @@ def main():
                     b = dict(base[key])
                     print(row([name, text] + [num(b.get(k), k) if k in b else "" for k, _ in METRICS] + [""] * len(PHYSICS)), flush=True)
             print(row([name, label] + cells(m)), flush=True)
+            by_clip.append((name, label, m["by_clip"]))
+    if args.by_clip:
+        print()
+        print(row(["skeleton", "generator", "calibrated coverage % of each clip"]))
+        print(row(["---"] * 3))
+        for name, label, per in by_clip:
+            text = ", ".join(f"{clip} {'-' if v is None else f'{v:.1f}'}" for clip, v in per)
+            print(row([name, label, text]), flush=True)
     if args.steps_table and models:
         label, model = models[0]
         folder = args.steps_table

@@ -88,6 +88,9 @@ pub struct Movement {
     /// Percent of the clips' windows that a window of these motions comes as close to as the
     /// other clips do (its calibrated threshold).
     pub calibrated_coverage: f64,
+    /// The same per clip, in the clips' order: which of them the motions cover (`None` for a
+    /// clip left out of the comparison, or with no window).
+    pub calibrated_coverage_by_clip: Vec<Option<f64>>,
     /// Mean share of frames a foot is in contact, over feet and motions (`None`: no feet).
     pub duty_factor: Option<f64>,
     /// Share of frames with some feet down and some up, mean over motions (`None`: fewer
@@ -120,7 +123,7 @@ pub struct Reference<'a> {
     thresholds: Vec<f64>,
     /// Windows with a window of another clip at a finite distance: those the other clips
     /// cover, since each threshold is at least that distance.
-    covered_by_others: usize,
+    covered_by_others: Vec<bool>,
     footfalls: Footfalls,
     /// The median of the clip windows' nearest-window distances, in the point clips' units:
     /// the smallest threshold asked for (zoo clips repeat one another exactly, and a sample
@@ -382,7 +385,7 @@ impl<'a> Reference<'a> {
         // A window nothing else resembles (infinite distance: a one-clip skeleton's window
         // with no other far enough away) is judged at the floor.
         let thresholds = nearest.iter().map(|&d| if d.is_finite() { d.max(floor) } else { floor }).collect();
-        let covered_by_others = nearest.iter().filter(|d| d.is_finite()).count();
+        let covered_by_others = nearest.iter().map(|d| d.is_finite()).collect();
         let footfalls = Footfalls::new(points, &clips[0].feet);
         Ok(Reference { clips, points, energy, poses, targets, thresholds, covered_by_others, footfalls, threshold: floor, opts: opts.clone() })
     }
@@ -412,28 +415,36 @@ impl<'a> Reference<'a> {
 
     /// Percent of the clips' windows (except those of clip `skip`) that some window of
     /// `motions` comes within the window's threshold of.
-    fn coverage(&self, motions: &[PointClip], skip: Option<usize>) -> f64 {
+    /// Also the same per clip (see `by_clip`).
+    fn coverage(&self, motions: &[PointClip], skip: Option<usize>) -> (f64, Vec<Option<f64>>) {
         let w = self.opts.window;
-        let judged: Vec<usize> = (0..self.targets.len()).filter(|&i| Some(self.targets[i].0) != skip).collect();
         let candidates = windows(motions, w, self.opts.max_windows);
-        if judged.is_empty() || candidates.is_empty() {
-            return 0.0;
-        }
-        let covered: Vec<bool> = judged
-            .par_iter()
-            .map(|&i| {
+        let covered: Vec<bool> = (0..self.targets.len())
+            .into_par_iter()
+            .map(|i| {
                 let (c, s) = self.targets[i];
-                candidates.iter().any(|&(d, t)| window_distance(&self.points[c], s, &motions[d], t, w) <= self.thresholds[i])
+                Some(c) != skip && candidates.iter().any(|&(d, t)| window_distance(&self.points[c], s, &motions[d], t, w) <= self.thresholds[i])
             })
             .collect();
-        100.0 * covered.iter().filter(|&&b| b).count() as f64 / judged.len() as f64
+        self.by_clip(&covered, skip)
+    }
+
+    /// Percent of the judged windows (all but clip `skip`'s) that `covered` marks, overall
+    /// (0 when none is judged) and per clip.
+    fn by_clip(&self, covered: &[bool], skip: Option<usize>) -> (f64, Vec<Option<f64>>) {
+        let percent = |of: &dyn Fn(usize) -> bool| {
+            let judged: Vec<usize> = (0..self.targets.len()).filter(|&i| of(self.targets[i].0) && Some(self.targets[i].0) != skip).collect();
+            (!judged.is_empty()).then(|| 100.0 * judged.iter().filter(|&&i| covered[i]).count() as f64 / judged.len() as f64)
+        };
+        let per_clip = (0..self.points.len()).map(|c| percent(&|d| d == c)).collect();
+        (percent(&|_| true).unwrap_or(0.0), per_clip)
     }
 
     /// Percent of the clip windows that the other clips cover: 100 by the thresholds'
     /// construction, less any window no other clip has a window for (a one-clip skeleton's
     /// window with none far enough away); the clips' own row of the report.
-    fn coverage_leave_one_out(&self) -> f64 {
-        100.0 * self.covered_by_others as f64 / self.targets.len().max(1) as f64
+    fn coverage_leave_one_out(&self) -> (f64, Vec<Option<f64>>) {
+        self.by_clip(&self.covered_by_others, None)
     }
 
     /// Score `motions` (world clips and the same as point clips, in one order) against the
@@ -463,12 +474,14 @@ impl<'a> Reference<'a> {
         let stats: Vec<(Option<f64>, Option<f64>)> = motions.iter().map(|c| contact_stats(c, &self.opts.contact)).collect();
         let alternations: Vec<(f64, f64)> = motions.iter().zip(points).filter_map(|(c, p)| alternation_parts(p, &c.feet)).collect();
         let swings: Vec<(f64, f64)> = motions.iter().filter_map(swing_parts).collect();
+        let coverage = self.coverage(points, skip);
         Ok(Movement {
             energy: mean,
             energy_ratio: ratio(mean),
             energy_ratio_range: (ratio(lo), ratio(hi)),
             nearest_pose: pose_sum / frames.max(1) as f64,
-            calibrated_coverage: self.coverage(points, skip),
+            calibrated_coverage: coverage.0,
+            calibrated_coverage_by_clip: coverage.1,
             duty_factor: footfall::mean(&stats.iter().filter_map(|s| s.0).collect::<Vec<f64>>()),
             mixed_contact: footfall::mean(&stats.iter().filter_map(|s| s.1).collect::<Vec<f64>>()),
             alternation: pooled(&alternations),
@@ -508,6 +521,7 @@ impl<'a> Reference<'a> {
         };
         let energies: Vec<f64> = self.clips.iter().map(|c| energy(c, self.opts.smooth_frames)).collect();
         let ratio = |e: f64| if self.energy > 0.0 { e / self.energy } else { 0.0 };
+        let coverage = self.coverage_leave_one_out();
         Ok(Movement {
             energy: self.energy,
             energy_ratio: 1.0,
@@ -516,7 +530,8 @@ impl<'a> Reference<'a> {
                 ratio(energies.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
             ),
             nearest_pose: parts.iter().zip(&weights).map(|(p, w)| p.0 * w).sum::<f64>() / total,
-            calibrated_coverage: self.coverage_leave_one_out(),
+            calibrated_coverage: coverage.0,
+            calibrated_coverage_by_clip: coverage.1,
             duty_factor: avg_opt(&|p| p.1),
             mixed_contact: avg_opt(&|p| p.2),
             alternation: pooled(&parts.iter().filter_map(|p| p.3).collect::<Vec<_>>()),
@@ -619,6 +634,29 @@ mod tests {
         assert_eq!(m.calibrated_coverage, 100.0);
         assert!(r.energy() > 0.0);
         assert_eq!(r.clips_baseline().unwrap(), m);
+    }
+
+    #[test]
+    fn coverage_by_clip_counts_each_clips_windows() {
+        // The walk twice: every window has an exact twin in the other clip, so every
+        // threshold is 0 and a window is covered only by itself.
+        let (clip, points) = walk();
+        let (clips, pts) = (vec![clip.clone(), clip.clone()], vec![points.clone(), points.clone()]);
+        let r = Reference::new(&clips, &pts, &MovementOptions::default()).unwrap();
+        assert_eq!(r.threshold, 0.0);
+        // Its first 40 frames hold the windows starting at frames 0-25 of each copy.
+        let head = PointClip::new(40, points.dims(), points.values()[..40 * points.dims()].to_vec()).unwrap();
+        let head_world = WorldClip { frames: 40, positions: clip.positions[..40 * clip.positions.len() / clip.frames].to_vec(), ..clip.clone() };
+        let share = 100.0 * 26.0 / (points.frames() - 14) as f64;
+        let m = r.score(std::slice::from_ref(&head_world), std::slice::from_ref(&head), None).unwrap();
+        assert!((m.calibrated_coverage - share).abs() < 1e-9, "{} against {share}", m.calibrated_coverage);
+        assert_eq!(m.calibrated_coverage_by_clip, vec![Some(m.calibrated_coverage); 2]);
+        // The clip left out has no share; a statue covers neither.
+        let m = r.score(std::slice::from_ref(&head_world), std::slice::from_ref(&head), Some(1)).unwrap();
+        assert_eq!(m.calibrated_coverage_by_clip, vec![Some(m.calibrated_coverage), None]);
+        let (world, point) = r.mean_pose(2, 60);
+        assert_eq!(r.score(&world, &point, None).unwrap().calibrated_coverage_by_clip, vec![Some(0.0); 2]);
+        assert_eq!(r.clips_baseline().unwrap().calibrated_coverage_by_clip, vec![Some(100.0); 2]);
     }
 
     #[test]

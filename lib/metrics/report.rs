@@ -267,6 +267,7 @@ pub fn generation_report(gt: &[Clip], gen: &[Clip], section: &AnyTopSection, opt
             ("energy_ratio_range", "lowest and highest ratio of one motion"),
             ("nearest_pose", "pairwise joint distances / body size, mean absolute difference"),
             ("calibrated_coverage", "percent of ground-truth windows within the calibrated threshold"),
+            ("calibrated_coverage_by_clip", "the same per ground-truth clip, in the order of movement.clips (null: the clip left out, or too short for a window)"),
             ("threshold", "mean joint distance, AnyTop units (a quantile of the clips' own nearest-window distances)"),
             ("duty_factor", "share of frames a foot is in contact"),
             ("mixed_contact", "share of frames with some feet down and some up"),
@@ -300,6 +301,7 @@ fn movement_report(gt: &[Clip], gen: &[Clip], gt_points: &[PointClip], gen_point
     let (crop_world, crop_points) = reference.random_crops(count, frames, seed);
     let crops = reference.score(&crop_world, &crop_points, None)?;
     Ok(json!({
+        "clips": gt.iter().map(|c| c.name.as_str()).collect::<Vec<_>>(),
         "threshold": reference.threshold,
         "footfall_chance": reference.footfall_chance(seed),
         "samples": samples,
