@@ -212,9 +212,11 @@ pub struct Args {
     /// skeleton's most moving clip's, such as an idle) W times as often as a moving clip of the
     /// same skeleton; 0 leaves them out. On one zoo quadruped's five clips, the standing idle
     /// drawn as often as the others, or a quarter as often, left the samples' fore legs leading
-    /// at random; left out, they led as the clips' (models/zoo-small-next/MODEL_CARD.md, "Which
-    /// fore leg leads") [default: 1 for a new run; a fine-tune or a resumed run keeps its
-    /// model's, unless this is given].
+    /// at random; left out, they led as the clips'. On three zoo skeletons trained together,
+    /// leaving the idles out did not: the fore legs led at random as often, and the samples no
+    /// longer covered the idles (models/zoo-small-next/MODEL_CARD.md, "Which fore leg leads" and
+    /// "Which clips the samples cover") [default: 1 for a new run; a fine-tune or a resumed run
+    /// keeps its model's, unless this is given].
     #[arg(long, value_name = "W", value_parser = bounds::non_negative(1.0))]
     pub still_weight: Option<f64>,
     /// Save a checkpoint at least this often.
