@@ -32,6 +32,16 @@ fn preset_args<'a>(data: &'a [PathBuf], out: &'a Path, steps: &'a str, preset: &
     args
 }
 
+/// A new run given `option value` exits 2 with one line naming the option, before writing any
+/// checkpoint.
+fn refused_new_run(dir: &Path, data: &[PathBuf], option: &str, value: &str) {
+    let other = dir.join("other");
+    let mut args = train_args(data, &other, "1");
+    args.extend([option, value]);
+    common::check_failure("mo-train", &format!("{option} {value}"), &run("mo-train", &args, None), option);
+    assert!(!other.join("checkpoint.json").exists());
+}
+
 fn info(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("checkpoint.json")).unwrap()).unwrap()
 }
@@ -282,11 +292,7 @@ fn the_noise_shift_is_recorded_and_kept_on_resume() {
     // The sampler reads the schedule from the checkpoint.
     let sample = run("mo-sample", &[s(&data[0].join("biped_walk.bvh")), "--model", s(&out), "--frames", "8", "--steps", "3"], None);
     ok(&sample, "sample");
-    let other = dir.join("other");
-    let mut args = train_args(&data, &other, "1");
-    args.extend(["--noise-shift", "0.5"]);
-    common::check_failure("mo-train", "shift 0.5", &run("mo-train", &args, None), "--noise-shift");
-    assert!(!other.join("checkpoint.json").exists());
+    refused_new_run(&dir, &data, "--noise-shift", "0.5");
 }
 
 /// A new run draws every clip alike and records nothing; a resumed run given --still-weight
@@ -309,11 +315,7 @@ fn the_still_weight_is_recorded_and_kept_on_resume() {
     args.push("--resume");
     ok(&run("mo-train", &args, None), "resume");
     assert_eq!(info(&out)["still_weight"].as_f64(), Some(0.25));
-    let other = dir.join("other");
-    let mut args = train_args(&data, &other, "1");
-    args.extend(["--still-weight", "2"]);
-    common::check_failure("mo-train", "still weight 2", &run("mo-train", &args, None), "--still-weight");
-    assert!(!other.join("checkpoint.json").exists());
+    refused_new_run(&dir, &data, "--still-weight", "2");
 }
 
 /// A new run records the default position jitter, a resumed run keeps its checkpoint's (0 for
@@ -385,11 +387,7 @@ fn the_loss_weighting_is_recorded_and_kept_on_resume() {
     ok(&changed, "resume with another weighting");
     assert!(String::from_utf8_lossy(&changed.stderr).contains("--loss-weighting v"), "no note about the change");
     assert_eq!(info(&out)["weighting"]["min-snr"].as_f64(), Some(2.0));
-    let other = dir.join("other");
-    let mut args = train_args(&data, &other, "1");
-    args.extend(["--loss-weighting", "eps"]);
-    common::check_failure("mo-train", "weighting eps", &run("mo-train", &args, None), "--loss-weighting");
-    assert!(!other.join("checkpoint.json").exists());
+    refused_new_run(&dir, &data, "--loss-weighting", "eps");
 }
 
 /// `--init DIR` starts a new run from that model's weights, size, noise schedule and position
